@@ -1,0 +1,186 @@
+"""Configuration: YAML validated on load, with errors that name the key.
+
+Keys carry their unit in their name (``_cm``, ``_kpa``, ``_ms``, ``_n``) so a
+reader of a config never has to guess.  ``load_config`` is the only entry
+point; it returns a frozen :class:`Config` and its content hash.
+"""
+
+from __future__ import annotations
+
+import difflib
+import hashlib
+import json
+from pathlib import Path
+from typing import Annotated, Literal
+
+import yaml
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+
+from .errors import ArticError
+
+DEFAULT_CONFIG = Path(__file__).resolve().parent.parent / "configs" / "default.yaml"
+
+Point2 = Annotated[list[float], Field(min_length=2, max_length=2)]
+Point3 = Annotated[list[float], Field(min_length=3, max_length=3)]
+Outline = Annotated[list[Point2], Field(min_length=2)]
+Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+NonNeg = Annotated[float, Field(ge=0, allow_inf_nan=False)]
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class TongueGeometry(_Strict):
+    midsagittal_outline_cm: Outline
+    gg_origin_cm: Point2
+    half_width_cm: Positive = 1.0
+    parasagittal_shrink: Annotated[float, Field(ge=0, lt=0.5)] = 0.08
+    parasagittal_drop_cm: float = 0.15
+    radial_sections: Annotated[int, Field(ge=2, le=40)] = 10
+    concentric_sections: Annotated[int, Field(ge=2, le=20)] = 6
+    inner_fraction: Annotated[float, Field(gt=0, lt=0.9)] = 0.2
+
+
+class WallSlice(_Strict):
+    z_cm: NonNeg
+    palate: Outline
+    pharynx: Outline
+    mandible: Outline
+
+
+class WallGeometry(_Strict):
+    lumen_reference_cm: Point2
+    points_per_outline: Annotated[int, Field(ge=3, le=400)] = 24
+    slices: Annotated[list[WallSlice], Field(min_length=2)]
+
+    @field_validator("slices")
+    @classmethod
+    def _increasing_z(cls, v):
+        zs = [s.z_cm for s in v]
+        if zs[0] != 0.0 or any(b <= a for a, b in zip(zs, zs[1:])):
+            raise ValueError("slices must start at z_cm: 0 and increase in z_cm")
+        return v
+
+
+class Speaker(_Strict):
+    name: str
+    tongue: TongueGeometry
+    wall: WallGeometry
+    landmarks_cm: dict[str, Point3]
+
+
+class TissueMaterial(_Strict):
+    density_g_cm3: Positive = 1.0
+    youngs_modulus_kpa: Positive = 20.0
+    viscosity_kpa_s: NonNeg = 2.0
+    poisson_ratio: Annotated[float, Field(gt=0.0, lt=0.5)] = 0.49
+    stiffening_strain: Positive = 0.2
+    stiffening_rate: NonNeg = 0.0
+
+
+class BoneMaterial(_Strict):
+    youngs_modulus_kpa: Positive = 9.6e6
+    viscosity_kpa_s: NonNeg = 9.6e5
+    mandible_mass_g: Positive = 150.0
+    hyoid_mass_g: Positive = 5.0
+
+
+class Materials(_Strict):
+    tongue: TissueMaterial
+    bone: BoneMaterial = BoneMaterial()
+
+
+class Simulation(_Strict):
+    dt_ms: Positive = 5.0
+    scheme: Literal["houbolt", "bdf1"] = "houbolt"
+    gravity_cm_s2: NonNeg = 980.0
+    volume_constraint: bool = True
+    fixed_node_sets: list[str] = ["anchor"]
+    newton_tol_cm: Positive = 1.0e-5
+    newton_max_iter: Annotated[int, Field(ge=1, le=200)] = 25
+    refactor_rate: Annotated[float, Field(gt=0, lt=1)] = 0.25
+    record_every: Annotated[int, Field(ge=1)] = 1
+
+
+class Cuboid(_Strict):
+    size_cm: Point3 = [6.0, 3.0, 2.0]
+    bricks: Annotated[list[int], Field(min_length=3, max_length=3)] = [5, 3, 2]
+    forces_n: list[NonNeg] = [0.1, 0.5, 1.0, 2.0, 3.0, 4.0]
+
+
+class Config(_Strict):
+    schema_version: Literal[1]
+    speaker: Speaker
+    materials: Materials
+    simulation: Simulation = Simulation()
+    cuboid: Cuboid = Cuboid()
+
+    @model_validator(mode="after")
+    def _landmarks(self):
+        return self
+
+
+_KNOWN_KEYS_CACHE: dict[type, set[str]] = {}
+
+
+def _known_keys(model: type[BaseModel]) -> set[str]:
+    return set(model.model_fields)
+
+
+def _format_error(path: Path, err: ValidationError) -> str:
+    first = err.errors()[0]
+    loc = ".".join(str(p) for p in first["loc"])
+    kind = first["type"]
+    if kind == "extra_forbidden":
+        # suggest the closest known key at that level
+        parent_loc = first["loc"][:-1]
+        model: type[BaseModel] = Config
+        for part in parent_loc:
+            field = model.model_fields.get(str(part)) if isinstance(part, str) else None
+            ann = getattr(field, "annotation", None) if field else None
+            if isinstance(ann, type) and issubclass(ann, BaseModel):
+                model = ann
+            else:
+                args = getattr(ann, "__args__", ()) if ann is not None else ()
+                sub = [a for a in args if isinstance(a, type) and issubclass(a, BaseModel)]
+                if sub:
+                    model = sub[0]
+        close = difflib.get_close_matches(str(first["loc"][-1]), _known_keys(model), n=1)
+        hint = f" (did you mean '{close[0]}'?)" if close else ""
+        return f"{path}: unknown key '{loc}'{hint}"
+    if kind == "missing":
+        return f"{path}: missing key '{loc}'"
+    return f"{path}: key '{loc}': {first['msg']}"
+
+
+def parse_config(data: object, source: Path | str = "<config>") -> Config:
+    if not isinstance(data, dict):
+        raise ArticError(f"{source}: config must be a YAML mapping; see configs/default.yaml")
+    try:
+        return Config.model_validate(data)
+    except ValidationError as err:
+        raise ArticError("config error: " + _format_error(Path(source), err) + "; fix the key and rerun") from None
+
+
+def read_yaml(path: Path | str, what: str = "file") -> object:
+    path = Path(path)
+    if not path.is_file():
+        raise ArticError(f"{what} not found: {path}; give an existing path")
+    try:
+        return yaml.safe_load(path.read_text())
+    except yaml.YAMLError as err:
+        mark = getattr(err, "problem_mark", None)
+        where = f" at line {mark.line + 1}" if mark is not None else ""
+        raise ArticError(f"{path}: malformed YAML{where}; fix the syntax and rerun") from None
+
+
+def load_config(path: Path | str | None = None) -> Config:
+    path = Path(path) if path is not None else DEFAULT_CONFIG
+    return parse_config(read_yaml(path, "config"), path)
+
+
+def config_hash(cfg: Config) -> str:
+    """Stable content hash (sha256 of canonical JSON) of a validated config."""
+    blob = json.dumps(cfg.model_dump(mode="json"), sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(blob.encode()).hexdigest()

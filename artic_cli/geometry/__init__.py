@@ -1,0 +1,1 @@
+"""Geometry: tongue mesh, cylinder truss, vocal-tract wall, hexahedron measures."""

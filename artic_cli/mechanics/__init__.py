@@ -1,0 +1,1 @@
+"""Mechanics: cylinders, volume constraint, assembly, integrator (CGS units inside)."""
