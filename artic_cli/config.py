@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Annotated, Literal
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from .errors import ArticError
 
@@ -77,6 +77,7 @@ class TissueMaterial(_Strict):
     poisson_ratio: Annotated[float, Field(gt=0.0, lt=0.5)] = 0.49
     stiffening_strain: Positive = 0.2
     stiffening_rate: NonNeg = 0.0
+    isotropic_truss: bool = True
 
 
 class BoneMaterial(_Strict):
@@ -116,12 +117,6 @@ class Config(_Strict):
     simulation: Simulation = Simulation()
     cuboid: Cuboid = Cuboid()
 
-    @model_validator(mode="after")
-    def _landmarks(self):
-        return self
-
-
-_KNOWN_KEYS_CACHE: dict[type, set[str]] = {}
 
 
 def _known_keys(model: type[BaseModel]) -> set[str]:

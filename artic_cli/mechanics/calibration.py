@@ -24,19 +24,21 @@ from scipy.optimize import brentq
 from ..geometry.hexahedra import volume_gradients
 from ..geometry.mesh import cuboid_mesh
 from .assembly import pair_blocks, sparse_blocks
+from .isotropy import isotropic_areas
 
 _CELLS = 4
 
 
-def lattice_response(bulk_ratio: float, cells: int = _CELLS) -> tuple[float, float]:
+def lattice_response(bulk_ratio: float, isotropic: bool = True, cells: int = _CELLS) -> tuple[float, float]:
     """Apparent (E, nu) of a cube lattice with unit cylinder modulus."""
     mesh = cuboid_mesh([float(cells)] * 3, [cells] * 3)
+    areas = isotropic_areas(mesh.nodes, mesh.bricks)[0] if isotropic else mesh.areas
     x = mesh.nodes
     ci, cj = mesh.cylinders[:, 0], mesh.cylinders[:, 1]
     d = x[cj] - x[ci]
     l0 = np.linalg.norm(d, axis=1)
     n = d / l0[:, None]
-    k = (mesh.areas / l0)[:, None, None] * np.einsum("ci,cj->cij", n, n)
+    k = (areas / l0)[:, None, None] * np.einsum("ci,cj->cij", n, n)
     kmat = sparse_blocks(mesh.cylinders, pair_blocks(k), len(x))
     if bulk_ratio > 0:
         vol, grad = volume_gradients(x, mesh.bricks)
@@ -62,12 +64,13 @@ def lattice_response(bulk_ratio: float, cells: int = _CELLS) -> tuple[float, flo
 
 
 @lru_cache(maxsize=16)
-def calibrate(poisson: float) -> tuple[float, float]:
+def calibrate(poisson: float, isotropic: bool = True) -> tuple[float, float]:
     """(modulus_scale, bulk_ratio): cylinder E = scale * E0, brick bulk = ratio * scale * E0."""
-    nu0 = lattice_response(0.0)[1]
+    nu0 = lattice_response(0.0, isotropic)[1]
     if poisson <= nu0:
         ratio = 0.0
     else:
-        ratio = float(np.exp(brentq(lambda s: lattice_response(np.exp(s))[1] - poisson, -8.0, 12.0, xtol=1e-10)))
-    e_eff = lattice_response(ratio)[0]
+        ratio = float(np.exp(brentq(lambda s: lattice_response(np.exp(s), isotropic)[1] - poisson,
+                                    -8.0, 12.0, xtol=1e-10)))
+    e_eff = lattice_response(ratio, isotropic)[0]
     return 1.0 / e_eff, ratio

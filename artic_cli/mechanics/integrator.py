@@ -87,7 +87,11 @@ def step(model: Model, state: State, control: Control, dt: float | None = None) 
         f_int, cs, _, grad = internal_forces(model, x, v)
         resid = (model.mass @ a - f_int - f_ext).ravel()[free]
         if factor is None:
-            factor = factorize(tangent_band(model, cs, grad, c_a, c_v), (c_a, c_v))
+            try:
+                factor = factorize(tangent_band(model, cs, grad, c_a, c_v), (c_a, c_v))
+            except np.linalg.LinAlgError:
+                raise SimulationDiverged(f"the tissue lost stability at t = {state.t * 1e3:.1f} ms (tangent not "
+                                         "positive definite); lower the loads or --dt") from None
             refactors += 1
             fresh = True
         dx = factor.solve(resid)

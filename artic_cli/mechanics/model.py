@@ -22,6 +22,7 @@ from ..geometry.mesh import Mesh
 from .assembly import BandFactor, BandPattern, band_pattern
 from .calibration import calibrate
 from .elements import CylinderSet
+from .isotropy import isotropic_areas
 
 
 @dataclass(frozen=True)
@@ -102,13 +103,14 @@ def build_model(mesh: Mesh, tissue: TissueMaterial, sim: Simulation, *,
                 volume_constraint: bool | None = None, fixed_sets: list[str] | None = None,
                 fixed_dofs: np.ndarray | None = None, gravity: float | None = None) -> Model:
     """Assemble the static model of a brick-and-cylinder body."""
-    scale, bulk_ratio = calibrate(tissue.poisson_ratio)
+    scale, bulk_ratio = calibrate(tissue.poisson_ratio, tissue.isotropic_truss)
+    stiff_area = isotropic_areas(mesh.nodes, mesh.bricks)[0] if tissue.isotropic_truss else mesh.areas.copy()
     e0 = units.kpa_to_cgs(tissue.youngs_modulus_kpa)
     eta0 = units.kpa_to_cgs(tissue.viscosity_kpa_s)
     ncyl = len(mesh.cylinders)
     ci, cj = mesh.cylinders[:, 0], mesh.cylinders[:, 1]
     full = lambda val: np.full(ncyl, float(val))  # noqa: E731
-    cyl = CylinderSet(i=ci, j=cj, l0=mesh.rest_lengths, area0=mesh.areas.copy(),
+    cyl = CylinderSet(i=ci, j=cj, l0=mesh.rest_lengths, area0=stiff_area,
                       youngs=full(scale * e0), viscosity=full(scale * eta0),
                       poisson=full(tissue.poisson_ratio), knee=full(tissue.stiffening_strain),
                       rate=full(tissue.stiffening_rate))
@@ -117,7 +119,7 @@ def build_model(mesh: Mesh, tissue: TissueMaterial, sim: Simulation, *,
     kappa = np.full(len(v0), bulk_ratio * scale * e0 if on else 0.0)
 
     n = len(mesh.nodes)
-    m = tissue.density_g_cm3 * cyl.area0 * cyl.l0
+    m = tissue.density_g_cm3 * mesh.areas * cyl.l0  # the paper's volumes carry the mass
     rows = np.concatenate([ci, cj, ci, cj])
     cols = np.concatenate([ci, cj, cj, ci])
     vals = np.concatenate([m / 3, m / 3, m / 6, m / 6])

@@ -1,0 +1,149 @@
+"""``artic``: build, simulate and validate the articulatory model.
+
+Each command is a thin shell over :mod:`artic_cli.stages`; bad input ends in
+one line on stderr and exit status 2 (3 for an unreachable target).
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import sys
+from pathlib import Path
+from typing import List, Optional
+
+import typer
+from rich.console import Console
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+from rich.table import Table
+
+from ..errors import ArticError
+
+app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
+                  help="A physiological articulatory model of the tongue, jaw and hyoid (after Dang & Honda 2004).")
+validate_app = typer.Typer(no_args_is_help=True, help="Check the tissue model against the paper's test bodies.")
+app.add_typer(validate_app, name="validate", help="Check the tissue model against the paper's test bodies (cuboid).")
+
+out_console = Console(width=None if sys.stdout.isatty() else 120)
+err_console = Console(stderr=True)
+
+
+def handle_errors(fn):
+    """Turn ArticError into one line on stderr and its exit status."""
+
+    @functools.wraps(fn)
+    def wrapper(*args, **kwargs):
+        try:
+            return fn(*args, **kwargs)
+        except ArticError as err:
+            err_console.print(f"[bold red]error:[/] {err}", highlight=False, soft_wrap=True)
+            raise typer.Exit(err.exit_code) from None
+        except KeyboardInterrupt:
+            err_console.print("interrupted; no partial output was kept")
+            raise typer.Exit(130) from None
+
+    return wrapper
+
+
+def _progress(label: str):
+    """A rich progress bar (done/total, ETA) when stderr is a terminal, else None."""
+    if not sys.stderr.isatty():
+        return None, None
+    bar = Progress(TextColumn(label), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+                   TextColumn("eta"), TimeRemainingColumn(), console=err_console, transient=True)
+    task = bar.add_task(label, total=None)
+
+    def update(done: int, total: int) -> None:
+        bar.update(task, completed=done, total=total)
+
+    return bar, update
+
+
+@app.command("build-mesh")
+@handle_errors
+def build_mesh_cmd(
+    config: Optional[Path] = typer.Option(None, "--config", help="Speaker config (YAML); default configs/default.yaml."),
+    out: Path = typer.Option(Path("data/mesh.h5"), "--out", help="Mesh artefact to write (HDF5)."),
+    plot: Optional[Path] = typer.Option(None, "--plot", help="Also draw the midsagittal view (PNG), like Fig. 1."),
+):
+    """Build the tongue mesh (bricks + cylinders) and the vocal-tract wall."""
+    from ..stages import build_mesh
+
+    s = build_mesh(config, out, plot)
+    rel = abs(s.cylinder_volume_cm3 - s.volume_cm3) / s.volume_cm3
+    out_console.print(f"wrote {s.path}: {s.nodes} nodes, {s.bricks} bricks, {s.cylinders} cylinders, "
+                      f"tongue volume {s.volume_cm3:.3f} cm^3 (cylinders {s.cylinder_volume_cm3:.3f} cm^3, "
+                      f"rel. diff {rel:.1e}), wall {s.wall_triangles} triangles"
+                      + (f"; figure {plot}" if plot else ""), highlight=False)
+
+
+@app.command("simulate")
+@handle_errors
+def simulate_cmd(
+    schedule: Path = typer.Option(..., "--schedule", help="Load schedule (YAML): node sets, forces in N, onset/duration in ms."),
+    duration: Optional[float] = typer.Option(None, "--duration", help="Simulated time in s (default: the schedule's duration_ms)."),
+    dt: Optional[float] = typer.Option(None, "--dt", help="Time step in s (default: the config's dt_ms)."),
+    mesh: Path = typer.Option(Path("data/mesh.h5"), "--mesh", help="Mesh artefact from build-mesh."),
+    config: Optional[Path] = typer.Option(None, "--config", help="Config the mesh was built from."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Output (HDF5); default data/sims/<schedule>.h5."),
+    volume_constraint: Optional[bool] = typer.Option(None, "--volume-constraint/--no-volume-constraint",
+                                                     help="Override the config's volume constraint."),
+    plot: Optional[Path] = typer.Option(None, "--plot", help="Draw start and end shapes (PNG)."),
+):
+    """Run the tissue model under a schedule of loads; write trajectories and volume."""
+    from ..stages import simulate
+
+    bar, update = _progress("simulating")
+    if bar is not None:
+        with bar:
+            r = simulate(schedule, duration, dt, mesh, config, out, volume_constraint, plot, update)
+    else:
+        r = simulate(schedule, duration, dt, mesh, config, out, volume_constraint, plot)
+    t = r.trajectory
+    sim_time = t.time[-1] - t.time[0]
+    out_console.print(
+        f"wrote {r.path}: {t.stats['steps']} steps of {t.stats['dt'] * 1e3:g} ms, wall {t.stats['wall_time_s']:.3f} s "
+        f"({t.stats['wall_time_s'] / sim_time:.3f} s per simulated s), max |volume change| "
+        f"{100 * r.max_volume_change:.3f} % (constraint {'on' if r.model.volume_constraint else 'off'}), "
+        f"inverted bricks {int(t.inverted.max())}" + (f"; figure {plot}" if plot else ""), highlight=False)
+
+
+@validate_app.command("cuboid")
+@handle_errors
+def validate_cuboid_cmd(
+    force: Optional[List[float]] = typer.Option(None, "--force", help="Pulling force in N (repeat); default from the config."),
+    config: Optional[Path] = typer.Option(None, "--config", help="Config for materials (default configs/default.yaml)."),
+    volume_constraint: Optional[bool] = typer.Option(None, "--volume-constraint/--no-volume-constraint"),
+    as_json: bool = typer.Option(False, "--json", help="Print the table as JSON."),
+):
+    """Pull the paper's 6 x 3 x 2 cm cuboid: strains, Poisson ratio (Eq. 4), volume change."""
+    import math
+
+    from ..config import load_config
+    from ..experiments.cuboid import rows_as_dicts, run_cuboid
+
+    if force is not None:
+        bad = [f for f in force if not math.isfinite(f) or f < 0]
+        if bad:
+            raise ArticError(f"--force must be finite and non-negative (N), got {bad[0]}")
+    rows = run_cuboid(load_config(config), force, volume_constraint)
+    if as_json:
+        out_console.print_json(json.dumps(rows_as_dicts(rows)))
+        return
+    table = Table(title="Cuboid 6 x 3 x 2 cm pulled along x (paper section II.B.3)",
+                  caption="nu: Eq. (4) with engineering strains; nu log: Eq. (4) integrated (Hencky strains)")
+    for col in ("F (N)", "axial", "lateral", "nu", "nu log", "dV", "dL (cm)", "FL/EA (cm)", "conv."):
+        table.add_column(col, justify="right")
+    for r in rows:
+        table.add_row(f"{r.force_n:g}", f"{r.axial_strain:.4f}", f"{r.lateral_strain:.4f}", f"{r.poisson_ratio:.3f}",
+                      f"{r.poisson_ratio_log:.3f}", f"{100 * r.volume_change:+.3f} %", f"{r.elongation_cm:.4f}",
+                      f"{r.linear_elongation_cm:.4f}", "yes" if r.converged else "NO")
+    out_console.print(table)
+
+
+def main() -> None:  # pragma: no cover - console entry
+    app()
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()

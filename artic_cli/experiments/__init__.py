@@ -1,0 +1,1 @@
+"""Numerical experiments that set the model beside the paper."""

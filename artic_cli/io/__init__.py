@@ -1,0 +1,1 @@
+"""Artefact store: HDF5 files written atomically, with provenance."""

@@ -1,0 +1,91 @@
+"""Running the integrator over time: trajectories and equilibria."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from ..geometry.hexahedra import inverted_bricks, volumes
+from .elements import strain_energy, evaluate
+from .integrator import step
+from .model import Control, Model, State
+from .volume import volume_energy
+
+
+@dataclass
+class Trajectory:
+    time: np.ndarray  # (T,) s
+    x: np.ndarray  # (T,N,3) cm
+    v: np.ndarray  # (T,N,3) cm/s
+    volume: np.ndarray  # (T,) cm^3
+    iterations: np.ndarray  # (T,) Newton iterations of the step ending there
+    energy: np.ndarray  # (T,) kinetic + stored elastic, erg
+    work: np.ndarray  # (T,) work done by external loads and gravity since t0, erg
+    inverted: np.ndarray  # (T,) number of bricks turned inside out
+    stats: dict = field(default_factory=dict)
+
+    @property
+    def volume_change(self) -> np.ndarray:
+        return self.volume / self.volume[0] - 1.0
+
+
+def mechanical_energy(model: Model, x: np.ndarray, v: np.ndarray) -> float:
+    kinetic = 0.5 * float(np.einsum("ij,ij->", v, model.mass @ v))
+    stored = float(strain_energy(model.cyl, evaluate(model.cyl, x, None).strain).sum())
+    if model.volume_constraint:
+        stored += volume_energy(x, model.bricks, model.brick_v0, model.kappa)
+    return kinetic + stored
+
+
+def run(model: Model, state: State, control_at: Callable[[float], Control], duration: float,
+        dt: float | None = None, record_every: int = 1,
+        progress: Callable[[int, int], None] | None = None) -> tuple[Trajectory, State]:
+    """Integrate for ``duration`` seconds; record every ``record_every`` steps."""
+    h = float(model.options.dt if dt is None else dt)
+    n_steps = max(1, int(round(duration / h)))
+    rec = [0]
+    times, xs, vs, its = [state.t], [state.x.copy()], [state.v.copy()], [0]
+    work = [0.0]
+    w = 0.0
+    gravity = model.node_mass[:, None] * model.gravity
+    t0 = time.perf_counter()
+    for k in range(1, n_steps + 1):
+        ctl = control_at(state.t + h)
+        new = step(model, state, ctl, h)
+        # work of external forces over the step (trapezoid on displacement)
+        w += float(np.einsum("ij,ij->", ctl.force + gravity, new.x - state.x))
+        state = new
+        if k % record_every == 0 or k == n_steps:
+            times.append(state.t)
+            xs.append(state.x.copy())
+            vs.append(state.v.copy())
+            its.append(state.iterations)
+            work.append(w)
+            rec.append(k)
+        if progress is not None:
+            progress(k, n_steps)
+    wall = time.perf_counter() - t0
+    x = np.array(xs)
+    v = np.array(vs)
+    vol = np.array([volumes(xi, model.bricks).sum() for xi in x])
+    energy = np.array([mechanical_energy(model, xi, vi) for xi, vi in zip(x, v)])
+    inv = np.array([len(inverted_bricks(xi, model.bricks)) for xi in x])
+    traj = Trajectory(time=np.array(times), x=x, v=v, volume=vol, iterations=np.array(its),
+                      energy=energy - energy[0], work=np.array(work), inverted=inv,
+                      stats={"steps": n_steps, "dt": h, "wall_time_s": wall, "refactors": state.refactors,
+                             "newton_iterations": int(np.sum(its))})
+    return traj, state
+
+
+def equilibrate(model: Model, state: State, control: Control, dt: float = 0.01, tol: float = 1e-4,
+                max_time: float = 5.0) -> tuple[State, bool]:
+    """Step under constant ``control`` until every speed is below ``tol`` cm/s."""
+    n = int(np.ceil(max_time / dt))
+    for _ in range(n):
+        state = step(model, state, control, dt)
+        if np.abs(state.v).max() < tol:
+            return state, True
+    return state, False

@@ -1,0 +1,1 @@
+"""Figures (matplotlib, Agg backend): axes in cm, legends, written atomically."""

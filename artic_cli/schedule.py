@@ -1,0 +1,68 @@
+"""Load schedules: what acts on the model, when (YAML, validated on load).
+
+Example::
+
+    duration_ms: 300          # optional; --duration overrides
+    loads:
+      - nodes: tip            # a named node set of the mesh
+        force_n: [0, 2.0, 0]  # total force in N, shared equally by the set's nodes
+        onset_ms: 0
+        duration_ms: 300
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
+
+from .config import _format_error, read_yaml
+from .errors import ArticError
+
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class LoadEntry(_Strict):
+    nodes: str
+    force_n: Annotated[list[Finite], Field(min_length=3, max_length=3)]
+    onset_ms: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 0.0
+    duration_ms: Annotated[float, Field(gt=0, allow_inf_nan=False)]
+
+
+class Schedule(_Strict):
+    duration_ms: Annotated[float, Field(gt=0, allow_inf_nan=False)] | None = None
+    loads: list[LoadEntry] = []
+
+    def check_duration(self, duration_ms: float, source: str = "schedule") -> None:
+        for k, e in enumerate(self.loads):
+            if e.onset_ms >= duration_ms:
+                raise ArticError(f"{source}: loads[{k}].onset_ms = {e.onset_ms:g} is not before the end of the run "
+                                 f"({duration_ms:g} ms); lower the onset or lengthen --duration")
+
+
+def parse_schedule(data: object, source: str = "<schedule>") -> Schedule:
+    if data is None:
+        data = {}
+    if not isinstance(data, dict):
+        raise ArticError(f"{source}: a schedule must be a YAML mapping with a 'loads' list")
+    try:
+        return Schedule.model_validate(data)
+    except ValidationError as err:
+        first = err.errors()[0]
+        loc = ".".join(str(p) for p in first["loc"])
+        if first["type"] == "extra_forbidden":
+            raise ArticError(f"schedule error: {source}: unknown key '{loc}'; valid keys are duration_ms, loads "
+                             "(nodes, force_n, onset_ms, duration_ms)") from None
+        raise ArticError(f"schedule error: {source}: key '{loc}': {first['msg']}") from None
+
+
+def load_schedule(path: Path | str) -> Schedule:
+    return parse_schedule(read_yaml(path, "schedule"), str(path))
+
+
+__all__ = ["Schedule", "LoadEntry", "load_schedule", "parse_schedule", "_format_error"]
