@@ -78,6 +78,7 @@ class TissueMaterial(_Strict):
     stiffening_strain: Positive = 0.2
     stiffening_rate: NonNeg = 0.0
     isotropic_truss: bool = True
+    volume_constraint_gain: Annotated[float, Field(ge=1.0, le=1000.0)] = 1.0
 
 
 class BoneMaterial(_Strict):
@@ -175,7 +176,16 @@ def load_config(path: Path | str | None = None) -> Config:
     return parse_config(read_yaml(path, "config"), path)
 
 
+def _digest(data) -> str:
+    blob = json.dumps(data, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(blob.encode()).hexdigest()
+
+
 def config_hash(cfg: Config) -> str:
     """Stable content hash (sha256 of canonical JSON) of a validated config."""
-    blob = json.dumps(cfg.model_dump(mode="json"), sort_keys=True, separators=(",", ":"))
-    return hashlib.sha256(blob.encode()).hexdigest()
+    return _digest(cfg.model_dump(mode="json"))
+
+
+def geometry_hash(cfg: Config) -> str:
+    """Hash of what the mesh depends on: the speaker's geometry only."""
+    return _digest(cfg.speaker.model_dump(mode="json"))

@@ -31,37 +31,49 @@ def shape_gradients(points: np.ndarray) -> np.ndarray:
 
 _DN_GAUSS = shape_gradients(GAUSS)  # (8 gauss, 8 corners, 3)
 _DN_CORNER = shape_gradients(REF)
+# dN as matrices for BLAS: (8 corners, G*3) with column g*3 + l
+_D_GAUSS = _DN_GAUSS.transpose(1, 0, 2).reshape(8, -1)
+_D_CORNER = _DN_CORNER.transpose(1, 0, 2).reshape(8, -1)
 
 
-def _jacobian_columns(x: np.ndarray, bricks: np.ndarray, dn: np.ndarray) -> np.ndarray:
-    """J[b, g, :, l] = sum_a x[brick a] dN_a/dxi_l (g): (B, G, 3, 3)."""
-    xe = x[bricks]  # (B,8,3)
-    return np.einsum("bai,gal->bgil", xe, dn)
+def _jacobians(x: np.ndarray, bricks: np.ndarray, d: np.ndarray) -> np.ndarray:
+    """J[b, i, g, l] = sum_a x[brick a, i] dN_a/dxi_l (g): (B, 3, G, 3)."""
+    xe = x[bricks].transpose(0, 2, 1)  # (B,3,8)
+    b = len(bricks)
+    return (xe.reshape(b * 3, 8) @ d).reshape(b, 3, -1, 3)
 
 
-def _det(j: np.ndarray) -> np.ndarray:
-    c1, c2, c3 = j[..., 0], j[..., 1], j[..., 2]
-    return np.einsum("...i,...i->...", c1, np.cross(c2, c3))
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cross product over the second axis of (B, 3, G) arrays."""
+    return np.stack([a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1],
+                     a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2],
+                     a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]], axis=1)
+
+
+def _dets(j: np.ndarray) -> np.ndarray:
+    c1, c2, c3 = j[..., 0], j[..., 1], j[..., 2]  # (B,3,G)
+    return (c1 * _cross(c2, c3)).sum(axis=1)  # (B,G)
 
 
 def volumes(x: np.ndarray, bricks: np.ndarray) -> np.ndarray:
     """Exact volume of every brick (B,)."""
-    return _det(_jacobian_columns(x, bricks, _DN_GAUSS)).sum(axis=1)
+    return _dets(_jacobians(x, bricks, _D_GAUSS)).sum(axis=1)
 
 
 def volume_gradients(x: np.ndarray, bricks: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Volumes (B,) and dV/dx of each corner (B, 8, 3)."""
-    j = _jacobian_columns(x, bricks, _DN_GAUSS)
+    j = _jacobians(x, bricks, _D_GAUSS)
     c1, c2, c3 = j[..., 0], j[..., 1], j[..., 2]
-    cof = np.stack([np.cross(c2, c3), np.cross(c3, c1), np.cross(c1, c2)], axis=-1)  # (B,G,3,3)
-    vol = np.einsum("bgi,bgi->b", c1, cof[..., 0])
-    grad = np.einsum("bgil,gal->bai", cof, _DN_GAUSS)
+    cof = np.stack([_cross(c2, c3), _cross(c3, c1), _cross(c1, c2)], axis=-1)  # (B,3,G,3)
+    vol = (c1 * cof[..., 0]).sum(axis=(1, 2))
+    b = len(bricks)
+    grad = (cof.reshape(b * 3, -1) @ _D_GAUSS.T).reshape(b, 3, 8).transpose(0, 2, 1)
     return vol, grad
 
 
 def corner_jacobians(x: np.ndarray, bricks: np.ndarray) -> np.ndarray:
     """det J at the eight corners (B, 8); a brick is inverted where any is <= 0."""
-    return _det(_jacobian_columns(x, bricks, _DN_CORNER))
+    return _dets(_jacobians(x, bricks, _D_CORNER))
 
 
 def inverted_bricks(x: np.ndarray, bricks: np.ndarray) -> np.ndarray:

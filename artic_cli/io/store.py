@@ -21,7 +21,7 @@ import h5py
 import numpy as np
 
 from .. import __version__
-from ..config import Config, config_hash, parse_config
+from ..config import Config, config_hash, geometry_hash, parse_config
 from ..errors import ArticError
 from ..geometry.mesh import Mesh
 from ..geometry.wall import PARTS, WallSurface
@@ -88,6 +88,7 @@ def save_mesh(path: Path | str, mesh: Mesh, wall: WallSurface, cfg: Config) -> N
     h = config_hash(cfg)
     with atomic_h5(path, "mesh", h) as f:
         f.attrs["config_yaml"] = yaml.safe_dump(cfg.model_dump(mode="json"), sort_keys=False)
+        f.attrs["geometry_hash"] = geometry_hash(cfg)
         t = f.create_group("tongue")
         _dataset(t, "nodes", mesh.nodes, "cm")
         _dataset(t, "bricks", mesh.bricks)
@@ -122,12 +123,12 @@ def load_mesh(path: Path | str, expect: Config | None = None) -> tuple[Mesh, Wal
                         grid=tuple(int(g) for g in t.attrs["grid"]))
             wall = WallSurface(vertices=w["vertices"][()], triangles=w["triangles"][()],
                                normals=w["normals"][()], part=w["part"][()])
-            stored_hash = f.attrs["config_hash"]
+            stored_hash = f.attrs["geometry_hash"]
         except (KeyError, OSError, ValueError, TypeError):
             raise ArticError(f"{path} is missing mesh data (truncated or from another tool); {MESH_HINT}") from None
-    if expect is not None and stored_hash != config_hash(expect):
-        raise ArticError(f"{path} was built from another config (hash {stored_hash[:12]}, "
-                         f"config {config_hash(expect)[:12]}); {MESH_HINT} --config <your config>")
+    if expect is not None and stored_hash != geometry_hash(expect):
+        raise ArticError(f"{path} was built from another speaker geometry (hash {stored_hash[:12]}, "
+                         f"config {geometry_hash(expect)[:12]}); {MESH_HINT} --config <your config>")
     return mesh, wall, cfg
 
 

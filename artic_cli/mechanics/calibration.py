@@ -64,13 +64,23 @@ def lattice_response(bulk_ratio: float, isotropic: bool = True, cells: int = _CE
 
 
 @lru_cache(maxsize=16)
-def calibrate(poisson: float, isotropic: bool = True) -> tuple[float, float]:
-    """(modulus_scale, bulk_ratio): cylinder E = scale * E0, brick bulk = ratio * scale * E0."""
+def calibrate(poisson: float, isotropic: bool = True, gain: float = 1.0) -> tuple[float, float]:
+    """(modulus_scale, bulk_ratio): cylinder E = scale * E0, brick bulk = ratio * scale * E0.
+
+    ``gain`` multiplies the bulk penalty found for ``poisson`` (the paper's
+    alpha, Eq. 7: how tightly volume is held); the modulus scale is then
+    recomputed so that the lattice's Young modulus stays E0."""
     nu0 = lattice_response(0.0, isotropic)[1]
     if poisson <= nu0:
         ratio = 0.0
     else:
         ratio = float(np.exp(brentq(lambda s: lattice_response(np.exp(s), isotropic)[1] - poisson,
                                     -8.0, 12.0, xtol=1e-10)))
+    ratio *= gain
     e_eff = lattice_response(ratio, isotropic)[0]
     return 1.0 / e_eff, ratio
+
+
+def effective_poisson(poisson: float, isotropic: bool = True, gain: float = 1.0) -> float:
+    """Small-strain Poisson ratio of the calibrated lattice with the constraint's gain."""
+    return lattice_response(calibrate(poisson, isotropic, gain)[1], isotropic)[1]

@@ -9,13 +9,22 @@ A = A0 (1 - nu e)^2, and carries the axial tension
 where E(e) = E0 below the stiffening strain and E0 exp(rate (e - e_s)) above
 it (Duck 1990, as the paper uses).  All functions take and return arrays over
 every cylinder at once, in CGS units.
+
+Within one time step the dashpot acts along the cylinder's axis at the start
+of the step, with that step's cross-section (``DampingFrame``).  The viscous
+force is then linear in the new velocities, its tangent c n n^T is exact and
+the Newton iteration stays robust when the tongue moves fast (the
+rotation of the axis within one step, a few degrees at most, is neglected
+for the dashpot only; it stays dissipative: power = c (n . dv)^2 >= 0).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
+import scipy.sparse as sp
 
 
 @dataclass(frozen=True)
@@ -31,22 +40,36 @@ class CylinderSet:
     poisson: np.ndarray  # nu of the radius law
     knee: np.ndarray  # stiffening strain
     rate: np.ndarray  # stiffening rate
+    n_nodes: int
 
     def __len__(self) -> int:
         return len(self.i)
 
+    @cached_property
+    def diff(self) -> sp.csr_matrix:
+        """(C, N) difference operator: (diff @ x)[c] = x[j_c] - x[i_c]."""
+        c, n = len(self.i), self.n_nodes
+        return sp.csr_matrix((np.r_[-np.ones(c), np.ones(c)], (np.r_[np.arange(c), np.arange(c)],
+                                                               np.r_[self.i, self.j])), shape=(c, n))
+
 
 @dataclass
 class CylinderState:
-    """Everything the forces and the tangent need, computed once per evaluation."""
+    """Everything the elastic forces and the tangent need, computed once per evaluation."""
 
     n: np.ndarray  # (C,3) unit axis i -> j
     length: np.ndarray
     strain: np.ndarray
-    tension: np.ndarray  # total (elastic + viscous), dyn
-    elastic: np.ndarray  # elastic part, dyn
+    elastic: np.ndarray  # elastic tension, dyn
     k_axial: np.ndarray  # dT_elastic/dl, dyn/cm
-    c_axial: np.ndarray  # dT/d(dl/dt), dyn s/cm
+
+
+@dataclass(frozen=True)
+class DampingFrame:
+    """Dashpot axes and coefficients, frozen over one time step."""
+
+    n: np.ndarray  # (C,3)
+    c: np.ndarray  # (C,) eta A / l0, dyn s/cm
 
 
 def youngs_modulus(cyl: CylinderSet, strain: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -58,25 +81,33 @@ def youngs_modulus(cyl: CylinderSet, strain: np.ndarray) -> tuple[np.ndarray, np
     return e, de
 
 
-def evaluate(cyl: CylinderSet, x: np.ndarray, v: np.ndarray | None) -> CylinderState:
-    d = x[cyl.j] - x[cyl.i]
-    length = np.sqrt(np.einsum("ij,ij->i", d, d))
+def evaluate(cyl: CylinderSet, x: np.ndarray) -> CylinderState:
+    d = cyl.diff @ x
+    length = np.sqrt((d * d).sum(axis=1))
     n = d / length[:, None]
     strain = length / cyl.l0 - 1.0
     shrink = np.maximum(1.0 - cyl.poisson * strain, 0.05)
     area = cyl.area0 * shrink * shrink
     e, de = youngs_modulus(cyl, strain)
     elastic = e * strain * area
-    c_axial = cyl.viscosity * area / cyl.l0
-    if v is not None:
-        rate = np.einsum("ij,ij->i", n, v[cyl.j] - v[cyl.i])
-        tension = elastic + c_axial * rate
-    else:
-        tension = elastic
     dsig = (e + de * strain) * shrink * shrink - 2.0 * cyl.poisson * e * strain * shrink
     k_axial = cyl.area0 * dsig / cyl.l0
-    return CylinderState(n=n, length=length, strain=strain, tension=tension, elastic=elastic,
-                         k_axial=k_axial, c_axial=c_axial)
+    return CylinderState(n=n, length=length, strain=strain, elastic=elastic, k_axial=k_axial)
+
+
+def damping_frame(cyl: CylinderSet, x: np.ndarray) -> DampingFrame:
+    cs = evaluate(cyl, x)
+    shrink = np.maximum(1.0 - cyl.poisson * cs.strain, 0.05)
+    return DampingFrame(n=cs.n, c=cyl.viscosity * cyl.area0 * shrink * shrink / cyl.l0)
+
+
+def axial_forces(cyl: CylinderSet, cs: CylinderState, frame: DampingFrame | None, v: np.ndarray | None) -> np.ndarray:
+    """(C,3) force vector each cylinder exerts on its first node (the second gets minus it)."""
+    f = cs.elastic[:, None] * cs.n
+    if frame is not None and v is not None:
+        rate = (frame.n * (cyl.diff @ v)).sum(axis=1)
+        f = f + (frame.c * rate)[:, None] * frame.n
+    return f
 
 
 def strain_energy(cyl: CylinderSet, strain: np.ndarray, points: int = 8) -> np.ndarray:

@@ -103,7 +103,7 @@ def build_model(mesh: Mesh, tissue: TissueMaterial, sim: Simulation, *,
                 volume_constraint: bool | None = None, fixed_sets: list[str] | None = None,
                 fixed_dofs: np.ndarray | None = None, gravity: float | None = None) -> Model:
     """Assemble the static model of a brick-and-cylinder body."""
-    scale, bulk_ratio = calibrate(tissue.poisson_ratio, tissue.isotropic_truss)
+    scale, bulk_ratio = calibrate(tissue.poisson_ratio, tissue.isotropic_truss, tissue.volume_constraint_gain)
     stiff_area = isotropic_areas(mesh.nodes, mesh.bricks)[0] if tissue.isotropic_truss else mesh.areas.copy()
     e0 = units.kpa_to_cgs(tissue.youngs_modulus_kpa)
     eta0 = units.kpa_to_cgs(tissue.viscosity_kpa_s)
@@ -113,7 +113,7 @@ def build_model(mesh: Mesh, tissue: TissueMaterial, sim: Simulation, *,
     cyl = CylinderSet(i=ci, j=cj, l0=mesh.rest_lengths, area0=stiff_area,
                       youngs=full(scale * e0), viscosity=full(scale * eta0),
                       poisson=full(tissue.poisson_ratio), knee=full(tissue.stiffening_strain),
-                      rate=full(tissue.stiffening_rate))
+                      rate=full(tissue.stiffening_rate), n_nodes=len(mesh.nodes))
     on = sim.volume_constraint if volume_constraint is None else volume_constraint
     v0 = volumes(mesh.nodes, mesh.bricks)
     kappa = np.full(len(v0), bulk_ratio * scale * e0 if on else 0.0)

@@ -34,7 +34,7 @@ class Trajectory:
 
 def mechanical_energy(model: Model, x: np.ndarray, v: np.ndarray) -> float:
     kinetic = 0.5 * float(np.einsum("ij,ij->", v, model.mass @ v))
-    stored = float(strain_energy(model.cyl, evaluate(model.cyl, x, None).strain).sum())
+    stored = float(strain_energy(model.cyl, evaluate(model.cyl, x).strain).sum())
     if model.volume_constraint:
         stored += volume_energy(x, model.bricks, model.brick_v0, model.kappa)
     return kinetic + stored
