@@ -81,7 +81,7 @@ def run_cuboid(cfg: Config, forces_n=None, volume_constraint: bool | None = None
     for fn in sorted(cfg.cuboid.forces_n if forces_n is None else forces_n):
         f = np.zeros_like(x0)
         f[face, 0] = units.newton_to_dyn(fn) * weights
-        state, ok = equilibrate(model, state, Control(force=f), dt=0.01, tol=1e-4, max_time=10.0)
+        state, ok = equilibrate(model, state, Control(force=f), dt=0.02, tol=1e-3, max_time=10.0)
         x = state.x
         axial = x[face, 0].mean() / size[0] - 1.0
         lat = []

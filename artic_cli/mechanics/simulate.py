@@ -11,7 +11,7 @@ import numpy as np
 from ..geometry.hexahedra import inverted_bricks, volumes
 from .elements import strain_energy, evaluate
 from .integrator import step
-from .model import Control, Model, State
+from .model import Control, Model, State, with_options
 from .volume import volume_energy
 
 
@@ -80,9 +80,13 @@ def run(model: Model, state: State, control_at: Callable[[float], Control], dura
     return traj, state
 
 
-def equilibrate(model: Model, state: State, control: Control, dt: float = 0.01, tol: float = 1e-4,
+def equilibrate(model: Model, state: State, control: Control, dt: float = 0.01, tol: float = 1e-3,
                 max_time: float = 5.0) -> tuple[State, bool]:
-    """Step under constant ``control`` until every speed is below ``tol`` cm/s."""
+    """Step under constant ``control`` until every speed is below ``tol`` cm/s.
+
+    Newton is tightened to 1e-7 cm here so that its own residual motion
+    (tolerance / dt) stays far below ``tol``."""
+    model = with_options(model, tol=min(model.options.tol, 1e-7))
     n = int(np.ceil(max_time / dt))
     for _ in range(n):
         state = step(model, state, control, dt)

@@ -1,0 +1,52 @@
+"""Shared fixtures: the default config, its mesh and model, a mesh file."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from artic_cli.config import load_config
+from artic_cli.geometry.mesh import tongue_mesh
+from artic_cli.geometry.wall import wall_surface
+from artic_cli.mechanics.model import build_model
+from artic_cli.stages import build_mesh
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+@pytest.fixture(scope="session")
+def cfg():
+    return load_config(ROOT / "configs" / "default.yaml")
+
+
+@pytest.fixture(scope="session")
+def mesh(cfg):
+    return tongue_mesh(cfg.speaker.tongue)
+
+
+@pytest.fixture(scope="session")
+def wall(cfg):
+    return wall_surface(cfg.speaker.wall)
+
+
+@pytest.fixture(scope="session")
+def model(cfg, mesh):
+    return build_model(mesh, cfg.materials.tongue, cfg.simulation)
+
+
+@pytest.fixture(scope="session")
+def mesh_file(tmp_path_factory):
+    out = tmp_path_factory.mktemp("mesh") / "mesh.h5"
+    build_mesh(ROOT / "configs" / "default.yaml", out)
+    return out
+
+
+def set_force(model, sets: dict[str, tuple[float, float, float]]) -> np.ndarray:
+    """Nodal force array (dyn) from {node set: total force in N}."""
+    f = np.zeros((model.n_nodes, 3))
+    for name, fn in sets.items():
+        idx = model.node_set(name)
+        f[idx] += np.asarray(fn) * 1e5 / len(idx)
+    return f
