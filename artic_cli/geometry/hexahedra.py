@@ -31,28 +31,27 @@ def shape_gradients(points: np.ndarray) -> np.ndarray:
 
 _DN_GAUSS = shape_gradients(GAUSS)  # (8 gauss, 8 corners, 3)
 _DN_CORNER = shape_gradients(REF)
-# dN as matrices for BLAS: (8 corners, G*3) with column g*3 + l
-_D_GAUSS = _DN_GAUSS.transpose(1, 0, 2).reshape(8, -1)
-_D_CORNER = _DN_CORNER.transpose(1, 0, 2).reshape(8, -1)
+# dN as matrices for BLAS: (8 corners, 3 * G) with column l * G + g
+_D_GAUSS = _DN_GAUSS.transpose(1, 2, 0).reshape(8, -1)
+_D_CORNER = _DN_CORNER.transpose(1, 2, 0).reshape(8, -1)
 
 
 def _jacobians(x: np.ndarray, bricks: np.ndarray, d: np.ndarray) -> np.ndarray:
-    """J[b, i, g, l] = sum_a x[brick a, i] dN_a/dxi_l (g): (B, 3, G, 3)."""
-    xe = x[bricks].transpose(0, 2, 1)  # (B,3,8)
+    """J[l, i, b, g] = sum_a x[brick b corner a, i] dN_a/dxi_l (point g), contiguous in (b, g)."""
     b = len(bricks)
-    return (xe.reshape(b * 3, 8) @ d).reshape(b, 3, -1, 3)
+    xs = x.T[:, bricks].reshape(3 * b, 8)  # rows (i, b)
+    j = (xs @ d).reshape(3, b, 3, -1)  # (i, b, l, g)
+    return np.ascontiguousarray(j.transpose(2, 0, 1, 3))
 
 
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Cross product over the second axis of (B, 3, G) arrays."""
-    return np.stack([a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1],
-                     a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2],
-                     a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]], axis=1)
+def _cross(a, b) -> list:
+    """Cross product of two 3-lists of equally shaped arrays."""
+    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 
 
 def _dets(j: np.ndarray) -> np.ndarray:
-    c1, c2, c3 = j[..., 0], j[..., 1], j[..., 2]  # (B,3,G)
-    return (c1 * _cross(c2, c3)).sum(axis=1)  # (B,G)
+    c = _cross(j[1], j[2])
+    return j[0][0] * c[0] + j[0][1] * c[1] + j[0][2] * c[2]  # (B, G)
 
 
 def volumes(x: np.ndarray, bricks: np.ndarray) -> np.ndarray:
@@ -61,14 +60,17 @@ def volumes(x: np.ndarray, bricks: np.ndarray) -> np.ndarray:
 
 
 def volume_gradients(x: np.ndarray, bricks: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Volumes (B,) and dV/dx of each corner (B, 8, 3)."""
+    """Volumes (B,) and dV/dx of each corner (B, 8, 3).
+
+    det J = c1 . (c2 x c3) with c_l the Jacobian's columns, so
+    d det / d c1 = c2 x c3 (and cyclically): the cofactor columns."""
     j = _jacobians(x, bricks, _D_GAUSS)
-    c1, c2, c3 = j[..., 0], j[..., 1], j[..., 2]
-    cof = np.stack([_cross(c2, c3), _cross(c3, c1), _cross(c1, c2)], axis=-1)  # (B,3,G,3)
-    vol = (c1 * cof[..., 0]).sum(axis=(1, 2))
+    cof = np.array([_cross(j[1], j[2]), _cross(j[2], j[0]), _cross(j[0], j[1])])  # (l, i, B, G)
+    vol = (j[0] * cof[0]).sum(axis=(0, 2))
     b = len(bricks)
-    grad = (cof.reshape(b * 3, -1) @ _D_GAUSS.T).reshape(b, 3, 8).transpose(0, 2, 1)
-    return vol, grad
+    g = cof.shape[-1]
+    grad = (cof.transpose(1, 2, 0, 3).reshape(3 * b, 3 * g) @ _D_GAUSS.T).reshape(3, b, 8)
+    return vol, grad.transpose(1, 2, 0)
 
 
 def corner_jacobians(x: np.ndarray, bricks: np.ndarray) -> np.ndarray:

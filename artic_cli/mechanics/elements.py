@@ -61,7 +61,9 @@ class CylinderState:
     length: np.ndarray
     strain: np.ndarray
     elastic: np.ndarray  # elastic tension, dyn
-    k_axial: np.ndarray  # dT_elastic/dl, dyn/cm
+    shrink: np.ndarray  # r / r0 (Eq. 4)
+    e: np.ndarray  # Young's modulus at this strain
+    de: np.ndarray  # its derivative
 
 
 @dataclass(frozen=True)
@@ -74,10 +76,12 @@ class DampingFrame:
 
 def youngs_modulus(cyl: CylinderSet, strain: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """E(e) and dE/de."""
-    over = np.maximum(strain - cyl.knee, 0.0)
-    growth = np.exp(np.minimum(cyl.rate * over, 50.0))
+    over = strain - cyl.knee
+    if not (over > 0).any():
+        return cyl.youngs, np.zeros_like(strain)
+    growth = np.exp(np.minimum(cyl.rate * np.maximum(over, 0.0), 50.0))
     e = cyl.youngs * growth
-    de = np.where(strain > cyl.knee, cyl.rate * e, 0.0)
+    de = np.where(over > 0, cyl.rate * e, 0.0)
     return e, de
 
 
@@ -87,18 +91,20 @@ def evaluate(cyl: CylinderSet, x: np.ndarray) -> CylinderState:
     n = d / length[:, None]
     strain = length / cyl.l0 - 1.0
     shrink = np.maximum(1.0 - cyl.poisson * strain, 0.05)
-    area = cyl.area0 * shrink * shrink
     e, de = youngs_modulus(cyl, strain)
-    elastic = e * strain * area
-    dsig = (e + de * strain) * shrink * shrink - 2.0 * cyl.poisson * e * strain * shrink
-    k_axial = cyl.area0 * dsig / cyl.l0
-    return CylinderState(n=n, length=length, strain=strain, elastic=elastic, k_axial=k_axial)
+    elastic = e * strain * cyl.area0 * (shrink * shrink)
+    return CylinderState(n=n, length=length, strain=strain, elastic=elastic, shrink=shrink, e=e, de=de)
+
+
+def axial_stiffness(cyl: CylinderSet, cs: CylinderState) -> np.ndarray:
+    """dT_elastic / dl of every cylinder, dyn/cm (needed only for the tangent)."""
+    dsig = (cs.e + cs.de * cs.strain) * cs.shrink * cs.shrink - 2.0 * cyl.poisson * cs.e * cs.strain * cs.shrink
+    return cyl.area0 * dsig / cyl.l0
 
 
 def damping_frame(cyl: CylinderSet, x: np.ndarray) -> DampingFrame:
     cs = evaluate(cyl, x)
-    shrink = np.maximum(1.0 - cyl.poisson * cs.strain, 0.05)
-    return DampingFrame(n=cs.n, c=cyl.viscosity * cyl.area0 * shrink * shrink / cyl.l0)
+    return DampingFrame(n=cs.n, c=cyl.viscosity * cyl.area0 * cs.shrink * cs.shrink / cyl.l0)
 
 
 def axial_forces(cyl: CylinderSet, cs: CylinderState, frame: DampingFrame | None, v: np.ndarray | None) -> np.ndarray:
@@ -106,7 +112,7 @@ def axial_forces(cyl: CylinderSet, cs: CylinderState, frame: DampingFrame | None
     f = cs.elastic[:, None] * cs.n
     if frame is not None and v is not None:
         rate = (frame.n * (cyl.diff @ v)).sum(axis=1)
-        f = f + (frame.c * rate)[:, None] * frame.n
+        f += (frame.c * rate)[:, None] * frame.n
     return f
 
 

@@ -49,7 +49,7 @@ def internal_forces(model: Model, x: np.ndarray, v: np.ndarray | None = None,
 def tangent_band(model: Model, cs: elements.CylinderState, frame: elements.DampingFrame, grad,
                  c_a: float, c_v: float) -> np.ndarray:
     k_geo = np.maximum(cs.elastic, 0.0) / cs.length
-    k_nn = np.maximum(cs.k_axial, 0.0) - k_geo
+    k_nn = np.maximum(elements.axial_stiffness(model.cyl, cs), 0.0) - k_geo
     k3 = (k_nn[:, None, None] * (cs.n[:, :, None] * cs.n[:, None, :]) + k_geo[:, None, None] * _EYE
           + (c_v * frame.c)[:, None, None] * (frame.n[:, :, None] * frame.n[:, None, :]))
     ab = c_a * model.mass_band + model.pattern.assemble(model.cyl_index, pair_blocks(k3))

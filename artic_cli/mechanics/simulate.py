@@ -8,8 +8,8 @@ from typing import Callable
 
 import numpy as np
 
-from ..geometry.hexahedra import inverted_bricks, volumes
-from .elements import strain_energy, evaluate
+from ..geometry.hexahedra import corner_jacobians, volumes
+from .elements import strain_energy
 from .integrator import step
 from .model import Control, Model, State, with_options
 from .volume import volume_energy
@@ -32,12 +32,31 @@ class Trajectory:
         return self.volume / self.volume[0] - 1.0
 
 
-def mechanical_energy(model: Model, x: np.ndarray, v: np.ndarray) -> float:
-    kinetic = 0.5 * float(np.einsum("ij,ij->", v, model.mass @ v))
-    stored = float(strain_energy(model.cyl, evaluate(model.cyl, x).strain).sum())
+def mechanical_energy(model: Model, x: np.ndarray, v: np.ndarray) -> np.ndarray | float:
+    """Kinetic + stored elastic energy (erg) of one state (N,3) or of frames (T,N,3)."""
+    frames = np.asarray(x)
+    single = frames.ndim == 2
+    xs, vs = (frames[None], np.asarray(v)[None]) if single else (frames, np.asarray(v))
+    t, n = xs.shape[:2]
+    mv = (model.mass @ vs.transpose(1, 0, 2).reshape(n, -1)).reshape(n, t, 3).transpose(1, 0, 2)
+    kinetic = 0.5 * (vs * mv).sum(axis=(1, 2))
+    d = xs[:, model.cyl.j] - xs[:, model.cyl.i]
+    strain = np.linalg.norm(d, axis=2) / model.cyl.l0 - 1.0
+    stored = np.array([strain_energy(model.cyl, s).sum() for s in strain])
     if model.volume_constraint:
-        stored += volume_energy(x, model.bricks, model.brick_v0, model.kappa)
-    return kinetic + stored
+        stored = stored + np.array([volume_energy(xi, model.bricks, model.brick_v0, model.kappa) for xi in xs])
+    total = kinetic + stored
+    return float(total[0]) if single else total
+
+
+def frame_volumes(model: Model, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Tongue volume and number of inverted bricks of every frame (T,N,3)."""
+    t, n = x.shape[:2]
+    bricks = (model.bricks[None] + n * np.arange(t)[:, None, None]).reshape(-1, 8)
+    flat = x.reshape(-1, 3)
+    vol = volumes(flat, bricks).reshape(t, -1).sum(axis=1)
+    bad = (corner_jacobians(flat, bricks) <= 0).any(axis=1).reshape(t, -1).sum(axis=1)
+    return vol, bad
 
 
 def run(model: Model, state: State, control_at: Callable[[float], Control], duration: float,
@@ -46,7 +65,6 @@ def run(model: Model, state: State, control_at: Callable[[float], Control], dura
     """Integrate for ``duration`` seconds; record every ``record_every`` steps."""
     h = float(model.options.dt if dt is None else dt)
     n_steps = max(1, int(round(duration / h)))
-    rec = [0]
     times, xs, vs, its = [state.t], [state.x.copy()], [state.v.copy()], [0]
     work = [0.0]
     w = 0.0
@@ -55,7 +73,7 @@ def run(model: Model, state: State, control_at: Callable[[float], Control], dura
     for k in range(1, n_steps + 1):
         ctl = control_at(state.t + h)
         new = step(model, state, ctl, h)
-        # work of external forces over the step (trapezoid on displacement)
+        # work of the external forces (held over the step) and gravity
         w += float(np.einsum("ij,ij->", ctl.force + gravity, new.x - state.x))
         state = new
         if k % record_every == 0 or k == n_steps:
@@ -64,19 +82,18 @@ def run(model: Model, state: State, control_at: Callable[[float], Control], dura
             vs.append(state.v.copy())
             its.append(state.iterations)
             work.append(w)
-            rec.append(k)
         if progress is not None:
             progress(k, n_steps)
     wall = time.perf_counter() - t0
     x = np.array(xs)
     v = np.array(vs)
-    vol = np.array([volumes(xi, model.bricks).sum() for xi in x])
-    energy = np.array([mechanical_energy(model, xi, vi) for xi, vi in zip(x, v)])
-    inv = np.array([len(inverted_bricks(xi, model.bricks)) for xi in x])
+    vol, inv = frame_volumes(model, x)
+    energy = mechanical_energy(model, x, v)
     traj = Trajectory(time=np.array(times), x=x, v=v, volume=vol, iterations=np.array(its),
                       energy=energy - energy[0], work=np.array(work), inverted=inv,
                       stats={"steps": n_steps, "dt": h, "wall_time_s": wall, "refactors": state.refactors,
-                             "newton_iterations": int(np.sum(its))})
+                             "newton_iterations": int(np.sum(its)),
+                             "diagnostics_time_s": time.perf_counter() - t0 - wall})
     return traj, state
 
 
