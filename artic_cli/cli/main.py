@@ -115,6 +115,7 @@ def validate_cuboid_cmd(
     config: Optional[Path] = typer.Option(None, "--config", help="Config for materials (default configs/default.yaml)."),
     volume_constraint: Optional[bool] = typer.Option(None, "--volume-constraint/--no-volume-constraint"),
     as_json: bool = typer.Option(False, "--json", help="Print the table as JSON."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Also write the rows as JSON to this file."),
 ):
     """Pull the paper's 6 x 3 x 2 cm cuboid: strains, Poisson ratio (Eq. 4), volume change."""
     import math
@@ -127,6 +128,10 @@ def validate_cuboid_cmd(
         if bad:
             raise ArticError(f"--force must be finite and non-negative (N), got {bad[0]}")
     rows = run_cuboid(load_config(config), force, volume_constraint)
+    if out is not None:
+        from ..io.store import write_text_atomic
+
+        write_text_atomic(out, json.dumps(rows_as_dicts(rows), indent=1))
     if as_json:
         out_console.print_json(json.dumps(rows_as_dicts(rows)))
         return
@@ -139,6 +144,19 @@ def validate_cuboid_cmd(
                       f"{r.poisson_ratio_log:.3f}", f"{100 * r.volume_change:+.3f} %", f"{r.elongation_cm:.4f}",
                       f"{r.linear_elongation_cm:.4f}", "yes" if r.converged else "NO")
     out_console.print(table)
+
+
+@app.command("report")
+@handle_errors
+def report_cmd(
+    data: Path = typer.Option(Path("data"), "--data", help="Folder holding the pipeline's artefacts."),
+    out: Path = typer.Option(Path("reports/paper.md"), "--out", help="Report to write (Markdown)."),
+):
+    """Write the report that sets our results beside the paper's."""
+    from ..report import write_report
+
+    path = write_report(data, out)
+    out_console.print(f"wrote {path}", highlight=False)
 
 
 def main() -> None:  # pragma: no cover - console entry

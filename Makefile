@@ -1,0 +1,57 @@
+# artic: reproducible runs.  `make setup paper` builds every stage and the report;
+# `make setup test` runs the tests.  Stages rerun only when their inputs changed.
+PYTHON ?= python3
+VENV   ?= .venv
+CONFIG ?= configs/default.yaml
+OUT    ?= data
+REPORT ?= reports
+
+PY     := $(VENV)/bin/python
+ARTIC  := $(VENV)/bin/artic
+SRC    := $(shell find artic_cli -name '*.py') pyproject.toml
+SCHED  := configs/schedules
+SIMS   := $(OUT)/sims
+
+.PHONY: setup mesh sims cuboid figures paper test bench clean
+.DELETE_ON_ERROR:
+
+setup: $(VENV)/.installed
+$(VENV)/.installed: pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(VENV)/bin/pip install --quiet --upgrade pip
+	$(VENV)/bin/pip install --quiet -e '.[test]'
+	touch $@
+
+# --- stages ---------------------------------------------------------------
+mesh: $(OUT)/mesh.h5
+$(OUT)/mesh.h5: $(CONFIG) $(SRC) | setup
+	$(ARTIC) build-mesh --config $(CONFIG) --out $@ --plot $(REPORT)/fig1_mesh.png
+
+cuboid: $(OUT)/cuboid.json
+$(OUT)/cuboid.json: $(CONFIG) $(SRC) | setup
+	$(ARTIC) validate cuboid --config $(CONFIG) --out $@
+
+$(SIMS)/%_novol.h5: $(SCHED)/%.yaml $(OUT)/mesh.h5
+	$(ARTIC) simulate --schedule $< --mesh $(OUT)/mesh.h5 --config $(CONFIG) --out $@ --no-volume-constraint
+
+$(SIMS)/%.h5: $(SCHED)/%.yaml $(OUT)/mesh.h5
+	$(ARTIC) simulate --schedule $< --mesh $(OUT)/mesh.h5 --config $(CONFIG) --out $@ --plot $(REPORT)/sim_$*.png
+
+sims: $(SIMS)/gravity.h5 $(SIMS)/pull_2n.h5 $(SIMS)/pull_2n_novol.h5 $(SIMS)/stress_7n.h5
+
+figures: mesh sims
+
+paper: $(REPORT)/paper.md
+$(REPORT)/paper.md: $(OUT)/mesh.h5 $(OUT)/cuboid.json $(SIMS)/gravity.h5 $(SIMS)/pull_2n.h5 \
+                    $(SIMS)/pull_2n_novol.h5 $(SIMS)/stress_7n.h5
+	$(ARTIC) report --data $(OUT) --out $@
+
+# --- checks ---------------------------------------------------------------
+test: setup
+	$(PY) -m pytest -q
+
+bench: setup
+	$(PY) benchmarks/bench_tissue.py
+
+clean:
+	rm -rf $(OUT)/*.h5 $(OUT)/*.json $(SIMS) $(REPORT)/*.png $(REPORT)/paper.md
