@@ -105,6 +105,36 @@ class Simulation(_Strict):
     record_every: Annotated[int, Field(ge=1)] = 1
 
 
+class Muscles(_Strict):
+    thickness_cm2: dict[str, Positive] = {
+        "GGa": 1.0, "GGm": 1.5, "GGp": 2.0, "HG": 1.5, "SG": 1.5, "SL": 1.0, "IL": 1.0, "T": 1.0, "V": 1.0,
+        "GH": 0.5, "MH": 1.0, "temporalis_anterior": 2.0, "temporalis_posterior": 1.5, "masseter": 2.5,
+        "medial_pterygoid": 2.0, "lateral_pterygoid_upper": 1.0, "lateral_pterygoid_lower": 1.0,
+        "anterior_digastric": 1.0, "posterior_digastric": 1.0}
+    passive_k1_ratio: NonNeg = 0.05
+    maxwell_k2_ratio: Positive = 2.0
+    maxwell_b2_ratio: Positive = 0.1
+    groups: dict[str, dict[str, Positive]] = {
+        "JO": {"lateral_pterygoid_upper": 0.25, "lateral_pterygoid_lower": 0.25, "anterior_digastric": 0.5},
+        "JC": {"temporalis_anterior": 0.3, "temporalis_posterior": 0.2, "masseter": 0.3, "medial_pterygoid": 0.2},
+        "T-SL": {"T": 1.0, "SL": 1.0}}
+
+
+class Jaw(_Strict):
+    link_area_cm2: Positive = 0.1
+    eminence_slope_deg: Annotated[float, Field(ge=-80, le=0)] = -30.0
+    guide_stiffness_n_per_cm: Positive = 1000.0
+    passive_stiffness_n_per_cm: NonNeg = 1.0
+    strap_stiffness_n_per_cm: NonNeg = 2.0
+    floor_link_area_cm2: Positive = 0.3
+
+
+class Contact(_Strict):
+    enabled: bool = True
+    stiffness_n_per_cm: Positive = 1000.0
+    tolerance_cm: Positive = 0.01
+
+
 class Cuboid(_Strict):
     size_cm: Point3 = [6.0, 3.0, 2.0]
     bricks: Annotated[list[int], Field(min_length=3, max_length=3)] = [5, 3, 2]
@@ -116,6 +146,9 @@ class Config(_Strict):
     speaker: Speaker
     materials: Materials
     simulation: Simulation = Simulation()
+    muscles: Muscles = Muscles()
+    jaw: Jaw = Jaw()
+    contact: Contact = Contact()
     cuboid: Cuboid = Cuboid()
 
 

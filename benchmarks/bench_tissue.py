@@ -67,7 +67,7 @@ def main() -> None:
 
     timers = Timers()
     timers.wrap(integrator, "internal_forces", "forces (cylinders + volume)")
-    timers.wrap(integrator, "tangent_band", "tangent assembly")
+    timers.wrap(integrator, "tangent", "tangent assembly")
     timers.wrap(integrator, "factorize", "banded Cholesky factorisation")
     orig_solve = assembly.BandFactor.solve
     timers.wrap(assembly.BandFactor, "solve", "banded solves")

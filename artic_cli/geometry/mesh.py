@@ -144,6 +144,7 @@ def tongue_mesh(geo: TongueGeometry) -> Mesh:
         "midsagittal_surface": idx(np.arange(nr + 1), nc, 1),
         "midsagittal": idx(K[:, :, 1], J[:, :, 1], 1).ravel(),
         "tip": np.array([idx(0, nc, 1)]),
+        "tip_line": idx(np.zeros_like(J[0]), J[0], P[0]).ravel(),
         "dorsum": np.array([idx(min(4, nr), nc, 1)]),
         "blade": idx(K[:3, -1, :], nc, P[:3, -1, :]).ravel(),
         "dorsum_region": idx(K[3:7, -1, :], nc, P[3:7, -1, :]).ravel(),

@@ -1,10 +1,17 @@
-"""Assembly into a fixed banded pattern and its Cholesky factorisation.
+"""Assembly into a fixed sparsity pattern and its factorisation.
 
-Free degrees of freedom are numbered along a reverse Cuthill-McKee order of
-the node graph, so every system matrix (mass, damping, tangent stiffness,
-volume tangent) is symmetric banded with half-bandwidth ``u``.  Each element
-block knows, once and for all, where its entries land in LAPACK's upper band
-storage ``ab[u + r - c, c]``; assembly is then one ``np.bincount``.
+Free degrees of freedom split into a *core* (the tongue's nodes, numbered
+along a band) and an optional *border* (the few bone nodes of the jaw and
+hyoid, which touch the whole tongue).  Every system matrix is then
+
+    [ A   B ]      A: symmetric banded, half-bandwidth u (LAPACK upper storage)
+    [ B^T C ]      B: dense n_core x n_border, C: dense n_border x n_border
+
+Each element block knows, once and for all, where its entries land in one
+flat storage (band | B | C | discard); assembly is one ``np.bincount``.  The
+factorisation is a banded Cholesky of A and a dense Cholesky of the Schur
+complement S = C - B^T A^-1 B, so a solve costs one banded solve plus small
+dense products.
 """
 
 from __future__ import annotations
@@ -13,79 +20,140 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.linalg import cho_solve_banded, cholesky_banded
+from scipy.linalg import cho_factor, cho_solve, cho_solve_banded, cholesky_banded
 from scipy.sparse.csgraph import reverse_cuthill_mckee
 
 
 @dataclass(frozen=True)
 class BandPattern:
-    n_free: int
-    u: int  # half bandwidth (upper)
-    dof_of: np.ndarray  # (3N,) position of each global dof in the band order, -1 if fixed
-    free_dofs: np.ndarray  # (n_free,) global dof at each band position
+    n_free: int  # core + border
+    n_core: int
+    u: int  # half bandwidth of the core (upper)
+    dof_of: np.ndarray  # (3N,) position of each global dof (core first, then border), -1 if fixed
+    free_dofs: np.ndarray  # (n_free,) global dof at each position
+
+    @property
+    def n_border(self) -> int:
+        return self.n_free - self.n_core
+
+    @property
+    def band_size(self) -> int:
+        return (self.u + 1) * self.n_core
 
     @property
     def size(self) -> int:
-        return (self.u + 1) * self.n_free
+        nb = self.n_border
+        return self.band_size + self.n_core * nb + nb * nb
 
     def block_index(self, nodes: np.ndarray) -> np.ndarray:
-        """Flat band indices of the dense blocks over ``nodes`` (E, k): (E, 3k, 3k).
-
-        Entries that are fixed or below the diagonal map to ``self.size`` (a
-        discard bin)."""
+        """Flat storage indices of dense blocks over ``nodes`` (E, k): (E, 3k, 3k); unused -> ``size``."""
         e, k = nodes.shape
         dofs = (3 * nodes[:, :, None] + np.arange(3)).reshape(e, 3 * k)
         pos = self.dof_of[dofs]
         r = pos[:, :, None]
         c = pos[:, None, :]
-        ok = (r >= 0) & (c >= 0) & (r <= c)
-        flat = (self.u + r - c) * self.n_free + c
-        return np.where(ok, flat, self.size)
+        nc, nb = self.n_core, self.n_border
+        valid = (r >= 0) & (c >= 0)
+        band = valid & (r < nc) & (c < nc) & (r <= c)
+        off = valid & (r < nc) & (c >= nc)
+        corner = valid & (r >= nc) & (c >= nc)
+        flat = np.full(r.shape[:1] + (3 * k, 3 * k), self.size, dtype=np.int64)
+        flat = np.where(band, (self.u + r - c) * nc + c, flat)
+        flat = np.where(off, self.band_size + r * nb + (c - nc), flat)
+        flat = np.where(corner, self.band_size + nc * nb + (r - nc) * nb + (c - nc), flat)
+        return flat
 
-    def assemble(self, index: np.ndarray, values: np.ndarray) -> np.ndarray:
-        """Sum ``values`` (same shape as ``index``) into band storage (u+1, n_free)."""
+    def diagonal_index(self, nodes: np.ndarray) -> np.ndarray:
+        """Indices of 3x3 blocks on the diagonal at ``nodes`` (E,): (E, 3, 3)."""
+        return self.block_index(nodes[:, None])
+
+    def assemble(self, index: np.ndarray, values: np.ndarray) -> "SystemMatrix":
         acc = np.bincount(index.ravel(), weights=values.ravel(), minlength=self.size + 1)
-        return acc[: self.size].reshape(self.u + 1, self.n_free)
+        return self.unpack(acc[: self.size])
+
+    def unpack(self, flat: np.ndarray) -> "SystemMatrix":
+        nc, nb = self.n_core, self.n_border
+        band = flat[: self.band_size].reshape(self.u + 1, nc)
+        b = flat[self.band_size: self.band_size + nc * nb].reshape(nc, nb)
+        c = flat[self.band_size + nc * nb:].reshape(nb, nb)
+        return SystemMatrix(band, b, c)
 
 
-def _half_bandwidth(order: np.ndarray, pairs: np.ndarray, free_mask: np.ndarray) -> tuple[int, np.ndarray, np.ndarray]:
+@dataclass
+class SystemMatrix:
+    band: np.ndarray
+    b: np.ndarray
+    c: np.ndarray
+
+    def __add__(self, other: "SystemMatrix") -> "SystemMatrix":
+        return SystemMatrix(self.band + other.band, self.b + other.b, self.c + other.c)
+
+    def __mul__(self, s: float) -> "SystemMatrix":
+        return SystemMatrix(self.band * s, self.b * s, self.c * s)
+
+    __rmul__ = __mul__
+
+
+def _half_bandwidth(order: np.ndarray, pairs: np.ndarray, core_free: np.ndarray):
     dof_order = (3 * order[:, None] + np.arange(3)).ravel()
-    free_dofs = dof_order[free_mask[dof_order]]
-    dof_of = np.full(free_mask.size, -1, dtype=np.int64)
-    dof_of[free_dofs] = np.arange(len(free_dofs))
+    free = dof_order[core_free[dof_order]]
+    dof_of = np.full(core_free.size, -1, dtype=np.int64)
+    dof_of[free] = np.arange(len(free))
     pos = dof_of[(3 * pairs[:, :, None] + np.arange(3)).reshape(len(pairs), 6)].astype(float)
     pos[pos < 0] = np.nan
-    both = ~np.isnan(pos).all(axis=1)
+    both = (~np.isnan(pos)).sum(axis=1) >= 2
     span = np.nanmax(pos[both], axis=1) - np.nanmin(pos[both], axis=1) if both.any() else np.zeros(1)
-    return max(int(span.max()), 2), dof_of, free_dofs
+    return max(int(span.max()), 2), dof_of, free
 
 
-def band_pattern(n_nodes: int, pairs: np.ndarray, fixed: np.ndarray) -> BandPattern:
+def band_pattern(n_nodes: int, pairs: np.ndarray, fixed: np.ndarray, n_core: int | None = None) -> BandPattern:
     """Pattern for a node graph with edges ``pairs`` and fixed dof mask (N,3).
 
-    The node order is the given numbering or its reverse Cuthill-McKee
-    permutation, whichever gives the narrower band."""
-    adj = sp.coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n_nodes, n_nodes))
-    adj = (adj + adj.T + sp.eye(n_nodes)).tocsr()
-    free_mask = ~np.asarray(fixed, dtype=bool).ravel()
-    candidates = [np.arange(n_nodes), reverse_cuthill_mckee(adj, symmetric_mode=True)]
-    u, dof_of, free_dofs = min((_half_bandwidth(o, pairs, free_mask) for o in candidates), key=lambda r: r[0])
-    return BandPattern(n_free=len(free_dofs), u=u, dof_of=dof_of, free_dofs=free_dofs)
+    Nodes ``0 .. n_core-1`` form the banded core, in their given order or in
+    reverse Cuthill-McKee order, whichever band is narrower; the other free
+    nodes form the dense border."""
+    n_core = n_nodes if n_core is None else n_core
+    fixed = np.asarray(fixed, dtype=bool)
+    core_pairs = pairs[(pairs < n_core).all(axis=1)] if len(pairs) else pairs
+    adj = sp.coo_matrix((np.ones(len(core_pairs)), (core_pairs[:, 0], core_pairs[:, 1])), shape=(n_core, n_core))
+    adj = (adj + adj.T + sp.eye(n_core)).tocsr()
+    core_free = np.zeros(3 * n_nodes, dtype=bool)
+    core_free[: 3 * n_core] = ~fixed[:n_core].ravel()
+    candidates = [np.arange(n_core), reverse_cuthill_mckee(adj, symmetric_mode=True)]
+    u, dof_of, free = min((_half_bandwidth(o, core_pairs, core_free) for o in candidates), key=lambda r: r[0])
+    n_core_free = len(free)
+    border = np.flatnonzero(~fixed[n_core:].ravel()) + 3 * n_core
+    dof_of[border] = n_core_free + np.arange(len(border))
+    return BandPattern(n_free=n_core_free + len(border), n_core=n_core_free, u=u, dof_of=dof_of,
+                       free_dofs=np.concatenate([free, border]))
 
 
 @dataclass
 class BandFactor:
-    """Cholesky factor of a banded SPD matrix with the coefficients it was built for."""
+    """Cholesky factors of a bordered banded SPD matrix, with the key it was built for."""
 
     cb: np.ndarray
     key: tuple
+    y: np.ndarray | None = None  # A^-1 B
+    b: np.ndarray | None = None
+    schur: tuple | None = None
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
-        return cho_solve_banded((self.cb, False), rhs, check_finite=False)
+        nc = self.cb.shape[1]
+        z1 = cho_solve_banded((self.cb, False), rhs[:nc], check_finite=False)
+        if self.schur is None:
+            return z1
+        x2 = cho_solve(self.schur, rhs[nc:] - self.b.T @ z1, check_finite=False)
+        return np.concatenate([z1 - self.y @ x2, x2])
 
 
-def factorize(ab: np.ndarray, key: tuple) -> BandFactor:
-    return BandFactor(cb=cholesky_banded(ab, lower=False, check_finite=False), key=key)
+def factorize(mat: SystemMatrix, key: tuple) -> BandFactor:
+    cb = cholesky_banded(mat.band, lower=False, check_finite=False)
+    if mat.c.size == 0:
+        return BandFactor(cb=cb, key=key)
+    y = cho_solve_banded((cb, False), mat.b, check_finite=False)
+    schur = cho_factor(mat.c - mat.b.T @ y, check_finite=False)
+    return BandFactor(cb=cb, key=key, y=y, b=mat.b, schur=schur)
 
 
 def sparse_blocks(nodes: np.ndarray, blocks: np.ndarray, n_nodes: int) -> sp.csr_matrix:

@@ -5,13 +5,14 @@ Euler (``bdf1``) for comparison.  Both write acceleration and velocity as
 linear functions of the new positions, a = c_a x + a*, v = c_v x + v*, so the
 step is the nonlinear system
 
-    R(x) = M a(x) - F_int(x, v(x)) - F_ext = 0
+    R(x) = M a(x) - F_int(x, v(x)) - F_muscle(x) - F_guide(x) - F_contact(x) - F_ext = 0
 
-with geometric nonlinearity (cylinders rotate and stretch).  It is solved by
-modified Newton: the banded Cholesky factor of
+with geometric nonlinearity (cylinders and fibres rotate and stretch).  It is
+solved by modified Newton: the Cholesky factor of
 J = c_a M + c_v C + K_t (positive semidefinite parts only) is kept across
 iterations and steps and rebuilt only when an iteration contracts the
-increment by less than ``refactor_rate`` or the step size changes.
+increment by less than ``refactor_rate``, the step size changes, or the set
+of wall contacts changes.
 """
 
 from __future__ import annotations
@@ -23,7 +24,9 @@ import numpy as np
 from ..errors import ArticError
 from . import elements
 from .assembly import factorize, pair_blocks
+from .contact import ContactPlanes, contact_planes, enforce
 from .model import Control, Model, State
+from .muscles import FibreState, fibre_state, muscle_forces
 from .volume import volume_forces
 
 _EYE = np.eye(3)
@@ -36,28 +39,68 @@ class SimulationDiverged(ArticError):
 
 def internal_forces(model: Model, x: np.ndarray, v: np.ndarray | None = None,
                     frame: elements.DampingFrame | None = None):
-    """Forces on the nodes from cylinders and the volume constraint (dyn)."""
+    """Forces on the nodes from cylinders, links and the volume constraint (dyn)."""
     cs = elements.evaluate(model.cyl, x)
     f = model.scatter @ elements.axial_forces(model.cyl, cs, frame, v)
     grad = vol = None
     if model.volume_constraint:
-        fv, vol, grad = volume_forces(x, model.bricks, model.brick_v0, model.kappa)
-        f += fv
+        fv, vol, grad = volume_forces(x[: model.n_tongue], model.bricks, model.brick_v0, model.kappa)
+        f[: model.n_tongue] += fv
     return f, cs, vol, grad
 
 
-def tangent_band(model: Model, cs: elements.CylinderState, frame: elements.DampingFrame, grad,
-                 c_a: float, c_v: float) -> np.ndarray:
+def guide_forces(model: Model, x: np.ndarray) -> np.ndarray:
+    f = np.zeros_like(x)
+    gd = model.guide
+    if gd is not None:
+        d = x[gd.nodes] - gd.origin
+        off = np.einsum("gi,gmi->gm", d, gd.normals)
+        f[gd.nodes] = -gd.stiffness * np.einsum("gm,gmi->gi", off, gd.normals)
+    return f
+
+
+def contact_forces(model: Model, x: np.ndarray, planes: ContactPlanes | None):
+    """Penalty forces of the nodes beyond their step's wall planes, and which are active."""
+    f = np.zeros_like(x)
+    if planes is None or len(planes.nodes) == 0:
+        return f, np.zeros(0, dtype=bool), np.zeros(0)
+    g = planes.gaps(x)
+    active = g > 0
+    mag = model.contact.stiffness * np.where(active, g, 0.0)
+    np.add.at(f, planes.nodes, -mag[:, None] * planes.n)
+    return f, active, mag
+
+
+def tangent(model: Model, cs: elements.CylinderState, frame: elements.DampingFrame, grad,
+            fs: FibreState | None, planes: ContactPlanes | None, active: np.ndarray, c_a: float, c_v: float):
     k_geo = np.maximum(cs.elastic, 0.0) / cs.length
     k_nn = np.maximum(elements.axial_stiffness(model.cyl, cs), 0.0) - k_geo
     k3 = (k_nn[:, None, None] * (cs.n[:, :, None] * cs.n[:, None, :]) + k_geo[:, None, None] * _EYE
           + (c_v * frame.c)[:, None, None] * (frame.n[:, :, None] * frame.n[:, None, :]))
-    ab = c_a * model.mass_band + model.pattern.assemble(model.cyl_index, pair_blocks(k3))
+    idx = [model.cyl_index]
+    val = [pair_blocks(k3)]
     if grad is not None:
         g = grad.reshape(len(model.brick_v0), 24)
         w = model.kappa / model.brick_v0
-        ab += model.pattern.assemble(model.brick_index, w[:, None, None] * g[:, :, None] * g[:, None, :])
-    return ab
+        idx.append(model.brick_index)
+        val.append(w[:, None, None] * g[:, :, None] * g[:, None, :])
+    if fs is not None:
+        t = np.maximum(fs.tension[model.muscles.seg_fibre], 0.0) / fs.seg_length
+        kk = t[:, None, None] * (_EYE - fs.n[:, :, None] * fs.n[:, None, :])
+        idx.append(model.seg_index)
+        val.append(pair_blocks(kk))
+    if model.guide is not None:
+        gd = model.guide
+        idx.append(gd.index)
+        val.append(gd.stiffness * np.einsum("gmi,gmj->gij", gd.normals, gd.normals))
+    if planes is not None and active.any():
+        pos = np.searchsorted(model.contact.nodes, planes.nodes[active])
+        n = planes.n[active]
+        idx.append(model.contact_index[pos])
+        val.append(model.contact.stiffness * n[:, :, None] * n[:, None, :])
+    flat_i = np.concatenate([i.ravel() for i in idx])
+    flat_v = np.concatenate([v.ravel() for v in val])
+    return c_a * model.mass_matrix + model.pattern.assemble(flat_i, flat_v)
 
 
 def _coefficients(model: Model, state: State, h: float):
@@ -89,33 +132,48 @@ def step(model: Model, state: State, control: Control, dt: float | None = None) 
     free = model.pattern.free_dofs
     x = _predict(state, h)
     x[model.fixed] = state.x[model.fixed]
-    factor = state.factor if state.factor is not None and state.factor.key == (c_a, c_v) else None
     refactors = state.refactors
     frame = elements.damping_frame(model.cyl, state.x)
+    planes = contact_planes(model.contact, state.x) if model.contact is not None else None
+    ms = model.muscles
+    act = control.activation if control.activation is not None else (np.zeros(len(ms.names)) if ms else None)
+    key = (c_a, c_v)
+    factor = state.factor if state.factor is not None and state.factor.key[:2] == key else None
+    active_prev = state.factor.key[2] if state.factor is not None and len(state.factor.key) > 2 else None
     prev = None
     fresh = False
+    fs = None
     for it in range(1, opt.max_iter + 1):
         a = c_a * x + a_known
         v = c_v * x + v_known
         f_int, cs, _, grad = internal_forces(model, x, v, frame)
-        resid = (model.mass @ a - f_int - f_ext).ravel()[free]
+        f = f_int + guide_forces(model, x)
+        if ms is not None:
+            fs = fibre_state(ms, x, act, state.sigma2, state.fibre_strain, h)
+            f += muscle_forces(ms, fs)
+        fc, active, _ = contact_forces(model, x, planes)
+        f += fc
+        active_key = None if planes is None else (tuple(planes.nodes[active]))
+        if factor is not None and planes is not None and active_key != active_prev:
+            factor = None
+        resid = (model.mass @ a - f - f_ext).ravel()[free]
         if factor is None:
             try:
-                factor = factorize(tangent_band(model, cs, frame, grad, c_a, c_v), (c_a, c_v))
+                factor = factorize(tangent(model, cs, frame, grad, fs, planes, active, c_a, c_v), (*key, active_key))
             except np.linalg.LinAlgError:
                 raise SimulationDiverged(f"the tissue lost stability at t = {state.t * 1e3:.1f} ms (tangent not "
                                          "positive definite); lower the loads or --dt") from None
             refactors += 1
             fresh = True
+            active_prev = active_key
         dx = factor.solve(resid)
         size = float(np.abs(dx).max()) if dx.size else 0.0
+        if not np.isfinite(size):
+            raise SimulationDiverged(f"simulation diverged at t = {state.t * 1e3:.1f} ms; try a smaller --dt")
         if size > _MAX_INCREMENT:  # damp wild iterates (stale factor, sudden loads)
             dx *= _MAX_INCREMENT / size
             factor = None if not fresh else factor
         x.reshape(-1)[free] -= dx
-
-        if not np.isfinite(size):
-            raise SimulationDiverged(f"simulation diverged at t = {state.t * 1e3:.1f} ms; try a smaller --dt")
         if size < opt.tol:
             break
         if prev is not None and size > opt.refactor_rate * prev and not fresh:
@@ -126,5 +184,17 @@ def step(model: Model, state: State, control: Control, dt: float | None = None) 
         raise SimulationDiverged(
             f"Newton did not converge at t = {state.t * 1e3:.1f} ms in {opt.max_iter} iterations; try a smaller --dt")
     v_new = c_v * x + v_known
+    projected = 0
+    contact_nodes = np.zeros(0, dtype=np.int64)
+    contact_force = np.zeros(0)
+    if model.contact is not None:
+        _, active, mag = contact_forces(model, x, planes)
+        contact_nodes, contact_force = planes.nodes[active], mag[active]
+        x, v_new, projected = enforce(model.contact, x, v_new)
+    sigma2, strain = state.sigma2, state.fibre_strain
+    if ms is not None:
+        fs = fibre_state(ms, x, act, state.sigma2, state.fibre_strain, h)
+        sigma2, strain = fs.sigma2, fs.strain
     return replace(state, t=state.t + h, x=x, v=v_new, history=history, history_dt=h, factor=factor,
-                   iterations=it, refactors=refactors)
+                   iterations=it, refactors=refactors, sigma2=sigma2, fibre_strain=strain,
+                   contact_nodes=contact_nodes, contact_force=contact_force, projected=projected)

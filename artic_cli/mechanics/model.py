@@ -1,10 +1,16 @@
 """Model (static), State (changes every step) and Control (inputs over time).
 
 As in MuJoCo's mjModel / mjData and Warp's Model / State / Control, the
-static model holds topology, rest geometry, materials and the solver's fixed
-sparsity pattern; the state holds positions, velocities, the integrator's
-history and a scratch factorisation; the control holds the external nodal
+static model holds topology, rest geometry, materials, muscle routing and the
+solver's fixed sparsity pattern; the state holds positions, velocities, the
+integrator's history, the muscles' internal (Maxwell) state and a scratch
+factorisation; the control holds the external nodal forces and the muscle
 forces of the current step.  Everything is CGS inside (cm, g, s, dyn).
+
+Two bodies share this model: the tongue alone (``build_model``: bricks and
+cylinders, some node sets held fixed) and the whole articulator
+(``build_articulator``: tongue, jaw and hyoid as stiff links, muscles,
+condyle guide, wall contact).
 """
 
 from __future__ import annotations
@@ -15,14 +21,18 @@ import numpy as np
 import scipy.sparse as sp
 
 from .. import units
-from ..config import Simulation, TissueMaterial
+from ..config import Config, Simulation, TissueMaterial
 from ..errors import ArticError
-from ..geometry.hexahedra import volume_gradients, volumes
+from ..geometry.anatomy import JAW_MUSCLES, LINK_KINDS, TONGUE_MUSCLES, Body, build_body
+from ..geometry.hexahedra import volumes
 from ..geometry.mesh import Mesh
+from ..geometry.wall import WallSurface
 from .assembly import BandFactor, BandPattern, band_pattern
 from .calibration import calibrate
+from .contact import ContactModel, contact_model
 from .elements import CylinderSet
 from .isotropy import isotropic_areas
+from .muscles import MuscleSet, muscle_set
 
 
 @dataclass(frozen=True)
@@ -35,8 +45,20 @@ class SolverOptions:
 
 
 @dataclass(frozen=True)
+class Guide:
+    """Nodes held on lines: force -k sum_m ((x - x0) . m) m over the normals m."""
+
+    nodes: np.ndarray  # (G,)
+    origin: np.ndarray  # (G,3)
+    normals: np.ndarray  # (G,2,3)
+    stiffness: float  # dyn/cm
+    index: np.ndarray  # (G,3,3) storage indices
+
+
+@dataclass(frozen=True)
 class Model:
     mesh: Mesh
+    rest: np.ndarray  # (N,3) all nodes
     cyl: CylinderSet
     bricks: np.ndarray
     brick_v0: np.ndarray
@@ -46,14 +68,27 @@ class Model:
     gravity: np.ndarray  # (3,) cm/s^2
     fixed: np.ndarray  # (N,3) bool
     pattern: BandPattern
-    cyl_index: np.ndarray  # (C,6,6) band indices
+    cyl_index: np.ndarray  # (C,6,6) storage indices
     brick_index: np.ndarray  # (B,24,24)
-    mass_band: np.ndarray  # (u+1, n_free)
+    mass_matrix: object  # SystemMatrix of M
     scatter: sp.csr_matrix  # (N, C): node force = scatter @ (T n)
     options: SolverOptions = field(default_factory=SolverOptions)
+    node_sets: dict = field(default_factory=dict)
+    names: dict = field(default_factory=dict)
+    muscles: MuscleSet | None = None
+    seg_index: np.ndarray | None = None  # (S,6,6)
+    groups: dict = field(default_factory=dict)  # group -> {muscle: share}
+    guide: Guide | None = None
+    contact: ContactModel | None = None
+    contact_index: np.ndarray | None = None  # (P,3,3) for contact nodes
+    wall: WallSurface | None = None
 
     @property
     def n_nodes(self) -> int:
+        return self.rest.shape[0]
+
+    @property
+    def n_tongue(self) -> int:
         return self.mesh.nodes.shape[0]
 
     @property
@@ -62,10 +97,18 @@ class Model:
 
     def node_set(self, name: str) -> np.ndarray:
         try:
-            return self.mesh.node_sets[name]
+            return self.node_sets[name]
         except KeyError:
-            valid = ", ".join(sorted(self.mesh.node_sets))
+            valid = ", ".join(sorted(self.node_sets))
             raise ArticError(f"unknown node set '{name}'; valid sets: {valid}") from None
+
+    @property
+    def muscle_names(self) -> tuple[str, ...]:
+        return self.muscles.names if self.muscles is not None else ()
+
+    def drivable(self) -> list[str]:
+        """Every name a schedule may drive: muscles and groups."""
+        return [*self.muscle_names, *self.groups]
 
 
 @dataclass
@@ -75,77 +118,35 @@ class State:
     v: np.ndarray  # (N,3) cm/s
     history: tuple[np.ndarray, ...] = ()  # previous positions, newest first
     history_dt: float = 0.0
+    sigma2: np.ndarray | None = None  # (F,) Maxwell stress of each fibre, dyn/cm^2
+    fibre_strain: np.ndarray | None = None  # (F,)
     factor: BandFactor | None = None  # scratch: reused factorisation
     iterations: int = 0  # Newton iterations of the last step
     refactors: int = 0  # factorisations so far
+    contact_nodes: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    contact_force: np.ndarray = field(default_factory=lambda: np.zeros(0))  # dyn, per contact node
+    projected: int = 0  # nodes put back on the wall after the last step
 
 
 @dataclass(frozen=True)
 class Control:
     force: np.ndarray  # (N,3) external nodal force, dyn
+    activation: np.ndarray | None = None  # (M,) muscle forces, dyn
 
 
 def rest_state(model: Model) -> State:
-    x = model.mesh.nodes.copy()
-    return State(t=0.0, x=x, v=np.zeros_like(x))
+    x = model.rest.copy()
+    nf = model.muscles.n_fibres if model.muscles is not None else 0
+    return State(t=0.0, x=x, v=np.zeros_like(x), sigma2=np.zeros(nf), fibre_strain=np.zeros(nf))
 
 
 def zero_control(model: Model) -> Control:
-    return Control(force=np.zeros((model.n_nodes, 3)))
+    return Control(force=np.zeros((model.n_nodes, 3)), activation=np.zeros(len(model.muscle_names)))
 
 
 def solver_options(sim: Simulation) -> SolverOptions:
     return SolverOptions(dt=units.ms_to_s(sim.dt_ms), scheme=sim.scheme, tol=sim.newton_tol_cm,
                          max_iter=sim.newton_max_iter, refactor_rate=sim.refactor_rate)
-
-
-def build_model(mesh: Mesh, tissue: TissueMaterial, sim: Simulation, *,
-                volume_constraint: bool | None = None, fixed_sets: list[str] | None = None,
-                fixed_dofs: np.ndarray | None = None, gravity: float | None = None) -> Model:
-    """Assemble the static model of a brick-and-cylinder body."""
-    scale, bulk_ratio = calibrate(tissue.poisson_ratio, tissue.isotropic_truss, tissue.volume_constraint_gain)
-    stiff_area = isotropic_areas(mesh.nodes, mesh.bricks)[0] if tissue.isotropic_truss else mesh.areas.copy()
-    e0 = units.kpa_to_cgs(tissue.youngs_modulus_kpa)
-    eta0 = units.kpa_to_cgs(tissue.viscosity_kpa_s)
-    ncyl = len(mesh.cylinders)
-    ci, cj = mesh.cylinders[:, 0], mesh.cylinders[:, 1]
-    full = lambda val: np.full(ncyl, float(val))  # noqa: E731
-    cyl = CylinderSet(i=ci, j=cj, l0=mesh.rest_lengths, area0=stiff_area,
-                      youngs=full(scale * e0), viscosity=full(scale * eta0),
-                      poisson=full(tissue.poisson_ratio), knee=full(tissue.stiffening_strain),
-                      rate=full(tissue.stiffening_rate), n_nodes=len(mesh.nodes))
-    on = sim.volume_constraint if volume_constraint is None else volume_constraint
-    v0 = volumes(mesh.nodes, mesh.bricks)
-    kappa = np.full(len(v0), bulk_ratio * scale * e0 if on else 0.0)
-
-    n = len(mesh.nodes)
-    m = tissue.density_g_cm3 * mesh.areas * cyl.l0  # the paper's volumes carry the mass
-    rows = np.concatenate([ci, cj, ci, cj])
-    cols = np.concatenate([ci, cj, cj, ci])
-    vals = np.concatenate([m / 3, m / 3, m / 6, m / 6])
-    mass = sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
-    node_mass = np.asarray(mass.sum(axis=1)).ravel()
-
-    if fixed_dofs is None:
-        fixed_dofs = np.zeros((n, 3), dtype=bool)
-        for name in (sim.fixed_node_sets if fixed_sets is None else fixed_sets):
-            if name not in mesh.node_sets:
-                valid = ", ".join(sorted(mesh.node_sets))
-                raise ArticError(f"unknown fixed node set '{name}'; valid sets: {valid}")
-            fixed_dofs[mesh.node_sets[name]] = True
-    pattern = band_pattern(n, mesh.cylinders, fixed_dofs)
-    cyl_index = pattern.block_index(mesh.cylinders)
-    brick_index = pattern.block_index(mesh.bricks)
-    mblock = np.kron(np.array([[2.0, 1.0], [1.0, 2.0]]), np.eye(3))[None] * (m / 6.0)[:, None, None]
-    mass_band = pattern.assemble(cyl_index, mblock)
-    scatter = sp.csr_matrix((np.concatenate([np.ones(ncyl), -np.ones(ncyl)]),
-                             (np.concatenate([ci, cj]), np.concatenate([np.arange(ncyl)] * 2))),
-                            shape=(n, ncyl))
-    g = sim.gravity_cm_s2 if gravity is None else gravity
-    return Model(mesh=mesh, cyl=cyl, bricks=mesh.bricks, brick_v0=v0, kappa=kappa, mass=mass,
-                 node_mass=node_mass, gravity=np.array([0.0, -g, 0.0]), fixed=fixed_dofs,
-                 pattern=pattern, cyl_index=cyl_index, brick_index=brick_index, mass_band=mass_band,
-                 scatter=scatter, options=solver_options(sim))
 
 
 def with_options(model: Model, **changes) -> Model:
@@ -156,5 +157,181 @@ def tongue_volume(model: Model, x: np.ndarray) -> float:
     return float(volumes(x, model.bricks).sum())
 
 
-__all__ = ["Model", "State", "Control", "SolverOptions", "build_model", "rest_state", "zero_control",
-           "with_options", "tongue_volume", "volume_gradients"]
+def tongue_cylinders(mesh: Mesh, tissue: TissueMaterial, n_nodes: int) -> tuple[CylinderSet, float, float]:
+    """Cylinders of the tongue (calibrated), the modulus scale and the bulk ratio."""
+    scale, bulk_ratio = calibrate(tissue.poisson_ratio, tissue.isotropic_truss, tissue.volume_constraint_gain)
+    stiff_area = isotropic_areas(mesh.nodes, mesh.bricks)[0] if tissue.isotropic_truss else mesh.areas.copy()
+    e0 = units.kpa_to_cgs(tissue.youngs_modulus_kpa)
+    eta0 = units.kpa_to_cgs(tissue.viscosity_kpa_s)
+    c = len(mesh.cylinders)
+    full = lambda val: np.full(c, float(val))  # noqa: E731
+    cyl = CylinderSet(i=mesh.cylinders[:, 0], j=mesh.cylinders[:, 1], l0=mesh.rest_lengths, area0=stiff_area,
+                      youngs=full(scale * e0), viscosity=full(scale * eta0), poisson=full(tissue.poisson_ratio),
+                      knee=full(tissue.stiffening_strain), rate=full(tissue.stiffening_rate), n_nodes=n_nodes)
+    return cyl, scale, bulk_ratio
+
+
+def _consistent_mass(i, j, m, n):
+    rows = np.concatenate([i, j, i, j])
+    cols = np.concatenate([i, j, j, i])
+    vals = np.concatenate([m / 3, m / 3, m / 6, m / 6])
+    return sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
+
+
+def _finish(mesh: Mesh, rest: np.ndarray, cyl: CylinderSet, link_mass: np.ndarray, kappa: np.ndarray,
+            fixed: np.ndarray, sim: Simulation, gravity: float, n_core: int, **extra) -> Model:
+    n = len(rest)
+    mass = _consistent_mass(cyl.i, cyl.j, link_mass, n)
+    node_mass = np.asarray(mass.sum(axis=1)).ravel()
+    pairs = [cyl.i[:, None], cyl.j[:, None]]
+    all_pairs = np.hstack(pairs)
+    ms = extra.get("muscles")
+    if ms is not None:
+        all_pairs = np.vstack([all_pairs, np.column_stack([ms.seg_i, ms.seg_j])])
+    pattern = band_pattern(n, all_pairs, fixed, n_core)
+    cyl_pairs = np.column_stack([cyl.i, cyl.j])
+    cyl_index = pattern.block_index(cyl_pairs)
+    brick_index = pattern.block_index(mesh.bricks)
+    mblock = np.kron(np.array([[2.0, 1.0], [1.0, 2.0]]), np.eye(3))[None] * (link_mass / 6.0)[:, None, None]
+    mass_matrix = pattern.assemble(cyl_index, mblock)
+    ncyl = len(cyl.i)
+    scatter = sp.csr_matrix((np.concatenate([np.ones(ncyl), -np.ones(ncyl)]),
+                             (np.concatenate([cyl.i, cyl.j]), np.concatenate([np.arange(ncyl)] * 2))), shape=(n, ncyl))
+    if ms is not None:
+        extra["seg_index"] = pattern.block_index(np.column_stack([ms.seg_i, ms.seg_j]))
+    guide = extra.pop("guide_spec", None)
+    if guide is not None:
+        nodes, origin, normals, k = guide
+        extra["guide"] = Guide(nodes=nodes, origin=origin, normals=normals, stiffness=k,
+                               index=pattern.diagonal_index(nodes))
+    if extra.get("contact") is not None:
+        extra["contact_index"] = pattern.diagonal_index(extra["contact"].nodes)
+    return Model(mesh=mesh, rest=rest, cyl=cyl, bricks=mesh.bricks, brick_v0=volumes(mesh.nodes, mesh.bricks),
+                 kappa=kappa, mass=mass, node_mass=node_mass, gravity=np.array([0.0, -gravity, 0.0]), fixed=fixed,
+                 pattern=pattern, cyl_index=cyl_index, brick_index=brick_index, mass_matrix=mass_matrix,
+                 scatter=scatter, options=solver_options(sim), **extra)
+
+
+def build_model(mesh: Mesh, tissue: TissueMaterial, sim: Simulation, *,
+                volume_constraint: bool | None = None, fixed_sets: list[str] | None = None,
+                fixed_dofs: np.ndarray | None = None, gravity: float | None = None) -> Model:
+    """The tongue alone: bricks and cylinders, with node sets held fixed."""
+    n = len(mesh.nodes)
+    cyl, scale, bulk_ratio = tongue_cylinders(mesh, tissue, n)
+    on = sim.volume_constraint if volume_constraint is None else volume_constraint
+    e0 = units.kpa_to_cgs(tissue.youngs_modulus_kpa)
+    kappa = np.full(len(mesh.bricks), bulk_ratio * scale * e0 if on else 0.0)
+    if fixed_dofs is None:
+        fixed_dofs = np.zeros((n, 3), dtype=bool)
+        for name in (sim.fixed_node_sets if fixed_sets is None else fixed_sets):
+            if name not in mesh.node_sets:
+                valid = ", ".join(sorted(mesh.node_sets))
+                raise ArticError(f"unknown fixed node set '{name}'; valid sets: {valid}")
+            fixed_dofs[mesh.node_sets[name]] = True
+    link_mass = tissue.density_g_cm3 * mesh.areas * cyl.l0  # the paper's volumes carry the mass
+    g = sim.gravity_cm_s2 if gravity is None else gravity
+    return _finish(mesh, mesh.nodes.copy(), cyl, link_mass, kappa, fixed_dofs, sim, g, n,
+                   node_sets=dict(mesh.node_sets))
+
+
+def _links(body: Body, cfg: Config, tissue_scale: float) -> tuple[CylinderSet, np.ndarray]:
+    """Passive links of the articulator: bones, carried points, floor, straps, jaw muscles' passive springs."""
+    jaw = cfg.jaw
+    bone = cfg.materials.bone
+    tissue = cfg.materials.tongue
+    x = body.nodes
+    pairs = [body.links]
+    kinds = [body.link_kind]
+    passive = np.array([f for m in JAW_MUSCLES for f in body.fibres[m]], dtype=np.int64)
+    pairs.append(passive)
+    kinds.append(np.full(len(passive), -1))
+    pairs = np.vstack(pairs)
+    kinds = np.concatenate(kinds)
+    i, j = pairs[:, 0], pairs[:, 1]
+    l0 = np.linalg.norm(x[j] - x[i], axis=1)
+    area = np.full(len(i), jaw.link_area_cm2)
+    e = np.zeros(len(i))
+    eta = np.zeros(len(i))
+    stiff = np.isin(kinds, [LINK_KINDS.index(k) for k in ("mandible", "hyoid", "carried")])
+    e[stiff] = units.kpa_to_cgs(bone.youngs_modulus_kpa)
+    eta[stiff] = units.kpa_to_cgs(bone.viscosity_kpa_s)
+    floor = kinds == LINK_KINDS.index("floor")
+    area[floor] = jaw.floor_link_area_cm2
+    e[floor] = tissue_scale * units.kpa_to_cgs(tissue.youngs_modulus_kpa)
+    eta[floor] = tissue_scale * units.kpa_to_cgs(tissue.viscosity_kpa_s)
+    relax = units.kpa_to_cgs(tissue.viscosity_kpa_s) / units.kpa_to_cgs(tissue.youngs_modulus_kpa)  # 0.1 s
+    for mask, k_n_cm in ((kinds == LINK_KINDS.index("strap"), jaw.strap_stiffness_n_per_cm),
+                         (kinds == -1, jaw.passive_stiffness_n_per_cm)):
+        k = units.newton_to_dyn(k_n_cm)  # dyn/cm
+        area[mask] = 1.0
+        e[mask] = k * l0[mask]
+        eta[mask] = relax * e[mask]
+    mass = np.zeros(len(i))
+    for kind, total in (("mandible", bone.mandible_mass_g), ("hyoid", bone.hyoid_mass_g)):
+        m = kinds == LINK_KINDS.index(kind)
+        mass[m] = total * l0[m] / l0[m].sum()  # spread uniformly over the bone's links
+    n = len(i)
+    cyl = CylinderSet(i=i, j=j, l0=l0, area0=area, youngs=e, viscosity=eta, poisson=np.zeros(n),
+                      knee=np.full(n, np.inf), rate=np.zeros(n), n_nodes=len(x))
+    return cyl, mass
+
+
+def _concat(a: CylinderSet, b: CylinderSet) -> CylinderSet:
+    return CylinderSet(**{f: np.concatenate([getattr(a, f), getattr(b, f)]) for f in
+                          ("i", "j", "l0", "area0", "youngs", "viscosity", "poisson", "knee", "rate")},
+                       n_nodes=a.n_nodes)
+
+
+def build_articulator(cfg: Config, mesh: Mesh, wall: WallSurface | None = None, *,
+                      volume_constraint: bool | None = None, contact: bool | None = None,
+                      gravity: float | None = None) -> Model:
+    """Tongue, jaw and hyoid with all muscles, the condyle guide and (optionally) wall contact."""
+    body = build_body(cfg, mesh)
+    n = len(body.nodes)
+    tissue = cfg.materials.tongue
+    tcyl, scale, bulk_ratio = tongue_cylinders(mesh, tissue, n)
+    lcyl, lmass = _links(body, cfg, scale)
+    cyl = _concat(tcyl, lcyl)
+    link_mass = np.concatenate([tissue.density_g_cm3 * mesh.areas * tcyl.l0, lmass])
+    on = cfg.simulation.volume_constraint if volume_constraint is None else volume_constraint
+    e0 = units.kpa_to_cgs(tissue.youngs_modulus_kpa)
+    kappa = np.full(len(mesh.bricks), bulk_ratio * scale * e0 if on else 0.0)
+    fixed = np.zeros((n, 3), dtype=bool)
+    fixed[body.fixed] = True
+
+    mc = cfg.muscles
+    names = list(TONGUE_MUSCLES + JAW_MUSCLES)
+    missing = [m for m in names if m not in mc.thickness_cm2]
+    if missing:
+        raise ArticError(f"config: muscles.thickness_cm2 lacks {', '.join(missing)}; add a thickness for each")
+    unknown = [m for m in mc.thickness_cm2 if m not in names]
+    if unknown:
+        raise ArticError(f"config: muscles.thickness_cm2 has unknown muscle '{unknown[0]}'; valid: {', '.join(names)}")
+    for g, members in mc.groups.items():
+        bad = [m for m in members if m not in names]
+        if bad:
+            raise ArticError(f"config: muscles.groups.{g} names unknown muscle '{bad[0]}'; valid: {', '.join(names)}")
+    ms = muscle_set(names, body.fibres, body.fibre_weight, mc.thickness_cm2, body.nodes,
+                    k1=mc.passive_k1_ratio * e0, k2=mc.maxwell_k2_ratio * e0,
+                    b2=mc.maxwell_b2_ratio * units.kpa_to_cgs(tissue.viscosity_kpa_s))
+
+    cond = np.array([body.names["condyle_l"], body.names["condyle_r"]])
+    a = np.deg2rad(cfg.jaw.eminence_slope_deg)
+    path = np.array([np.cos(a), np.sin(a), 0.0])
+    normals = np.array([[-path[1], path[0], 0.0], [0.0, 0.0, 1.0]])
+    guide = (cond, body.nodes[cond], np.broadcast_to(normals, (2, 2, 3)).copy(),
+             units.newton_to_dyn(cfg.jaw.guide_stiffness_n_per_cm))
+
+    cm = None
+    use_contact = cfg.contact.enabled if contact is None else contact
+    if use_contact and wall is not None:
+        sets = mesh.node_sets
+        nodes = np.unique(np.concatenate([sets["surface"], sets["tip_line"]]))
+        jaw_frame = np.array([body.names[k] for k in ("symphysis_l", "symphysis_r", "coronoid_l", "gonion_r",
+                                                      "condyle_l")])
+        cm = contact_model(wall, nodes, jaw_frame, body.nodes[jaw_frame],
+                           units.newton_to_dyn(cfg.contact.stiffness_n_per_cm), cfg.contact.tolerance_cm)
+    g = cfg.simulation.gravity_cm_s2 if gravity is None else gravity
+    return _finish(mesh, body.nodes.copy(), cyl, link_mass, kappa, fixed, cfg.simulation, g, len(mesh.nodes),
+                   node_sets=dict(body.node_sets), names=dict(body.names), muscles=ms,
+                   groups={k: dict(v) for k, v in mc.groups.items()}, guide_spec=guide, contact=cm, wall=wall)

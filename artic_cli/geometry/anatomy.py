@@ -1,0 +1,214 @@
+"""The whole articulator body: tongue mesh, jaw, hyoid, skull points and muscle routing.
+
+Node numbering: the 231 tongue nodes first (banded), then the bone nodes
+(mandible and hyoid, the "border" of the linear system), then the skull
+points muscles pull from (fixed).  All of it is geometry and topology; the
+forces live in :mod:`artic_cli.mechanics`.
+
+Mandible (paper Fig. 2f): four nodes a side (condyle, coronoid, gonion,
+symphysis) joined by five stiff links, two triangles (condyle-coronoid-gonion,
+coronoid-gonion-symphysis) sharing the shearing link coronoid-gonion; the two
+sides are tied by cross links so that the jaw is rigid in 3D.  Carried by
+the mandible (stiff links to four jaw nodes): the lower incisor point (the
+jaw control point), the geniohyoid origin, the mylohyoid line and the
+tongue's innermost concentric line (the genioglossus tendon at the genial
+tubercles).  Hyoid: body (two nodes) and two greater horns, braced.  The
+tongue floor line rests on the hyoid and mandible through soft links.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..config import Config
+from ..errors import ArticError
+from .mesh import Mesh, tongue_node_index, tongue_mesh
+
+LINK_KINDS = ("mandible", "hyoid", "carried", "floor", "strap")
+TONGUE_MUSCLES = ("GGa", "GGm", "GGp", "HG", "SG", "SL", "IL", "T", "V", "GH", "MH")
+JAW_MUSCLES = ("temporalis_anterior", "temporalis_posterior", "masseter", "medial_pterygoid",
+               "lateral_pterygoid_upper", "lateral_pterygoid_lower", "anterior_digastric", "posterior_digastric")
+
+
+@dataclass(frozen=True)
+class Body:
+    mesh: Mesh  # the tongue (nodes 0 .. n_tongue-1)
+    nodes: np.ndarray  # (N,3) every node, cm
+    names: dict[str, int]  # named points (bilateral ones end in _l / _r)
+    links: np.ndarray  # (L,2) passive links
+    link_kind: np.ndarray  # (L,) index into LINK_KINDS
+    fibres: dict[str, list[np.ndarray]]  # muscle -> fibres (node chains, origin first)
+    fibre_weight: dict[str, np.ndarray]  # muscle -> share of the muscle's force per fibre
+    fixed: np.ndarray  # skull points (all dofs fixed)
+    mandible: np.ndarray  # nodes moving with the mandible (incl. carried points)
+    hyoid: np.ndarray
+    node_sets: dict[str, np.ndarray] = field(default_factory=dict)
+
+    @property
+    def n_tongue(self) -> int:
+        return len(self.mesh.nodes)
+
+
+class _Builder:
+    def __init__(self, mesh: Mesh):
+        self.points = [p for p in mesh.nodes]
+        self.names: dict[str, int] = {}
+
+    def add(self, name: str, xyz) -> int:
+        self.points.append(np.asarray(xyz, dtype=float))
+        self.names[name] = len(self.points) - 1
+        return self.names[name]
+
+    def bilateral(self, name: str, xyz) -> tuple[int, int]:
+        x, y, z = xyz
+        return self.add(f"{name}_l", (x, y, abs(z))), self.add(f"{name}_r", (x, y, -abs(z)))
+
+
+def _landmark(cfg: Config, key: str):
+    try:
+        return cfg.speaker.landmarks_cm[key]
+    except KeyError:
+        raise ArticError(f"config: speaker.landmarks_cm lacks '{key}'; add it (x, y, z in cm)") from None
+
+
+def build_body(cfg: Config, mesh: Mesh | None = None) -> Body:
+    mesh = mesh if mesh is not None else tongue_mesh(cfg.speaker.tongue)
+    nr, nc, planes = mesh.grid
+    t = lambda k, j, p: int(tongue_node_index(k, j, p, nc - 1))  # noqa: E731
+    b = _Builder(mesh)
+    lm = lambda key: _landmark(cfg, key)  # noqa: E731
+
+    # --- mandible: 4 nodes a side + carried points --------------------------------
+    jaw = {}
+    for part in ("condyle", "coronoid", "gonion", "symphysis"):
+        jaw[part] = b.bilateral(part, lm(part))
+    incisor = b.add("lower_incisor", lm("lower_incisor"))
+    gh_origin = b.add("gh_origin", lm("gh_origin"))
+    myl_front = b.bilateral("mylohyoid_front", lm("mylohyoid_line_front"))
+    myl_back = b.bilateral("mylohyoid_back", lm("mylohyoid_line_back"))
+    mf, mb = np.asarray(lm("mylohyoid_line_front")), np.asarray(lm("mylohyoid_line_back"))
+    myl_mid = b.bilateral("mylohyoid_mid", tuple(0.5 * (mf + mb)))
+    dig_fossa = b.bilateral("digastric_fossa", lm("digastric_fossa"))
+    links, kinds = [], []
+
+    def link(a, c, kind):
+        links.append((a, c))
+        kinds.append(LINK_KINDS.index(kind))
+
+    for s in (0, 1):
+        c, r, g, y = (jaw[p][s] for p in ("condyle", "coronoid", "gonion", "symphysis"))
+        for a, d in ((c, r), (c, g), (r, g), (r, y), (g, y)):  # two triangles + shearing link
+            link(a, d, "mandible")
+    # cross links: the two halves form one rigid bone
+    L = {p: jaw[p][0] for p in jaw}
+    R = {p: jaw[p][1] for p in jaw}
+    for p in jaw:
+        link(L[p], R[p], "mandible")
+    for p, q in (("symphysis", "gonion"), ("symphysis", "condyle"), ("coronoid", "condyle"), ("gonion", "coronoid")):
+        link(L[p], R[q], "mandible")
+        link(R[p], L[q], "mandible")
+    frame = [jaw["symphysis"][0], jaw["symphysis"][1], jaw["coronoid"][0], jaw["gonion"][1]]
+    carried = [incisor, gh_origin, *myl_front, *myl_back, *myl_mid, *dig_fossa]
+    anchor = mesh.node_sets["anchor"]
+    for node in [*carried, *anchor]:
+        for f in frame:
+            link(int(node), f, "carried")
+
+    # --- hyoid: body ends and horn tips, braced ---------------------------------------
+    body_l, body_r = b.bilateral("hyoid_body", lm("hyoid_body_end"))
+    horn_l, horn_r = b.bilateral("hyoid_horn", lm("hyoid_horn_tip"))
+    for a, d in ((body_l, body_r), (body_l, horn_l), (body_r, horn_r), (body_l, horn_r), (body_r, horn_l),
+                 (horn_l, horn_r)):
+        link(a, d, "hyoid")
+    hyoid = np.array([body_l, body_r, horn_l, horn_r])
+
+    # --- tongue floor on hyoid and mandible (soft links) --------------------------------
+    for p in range(planes):
+        for j in range(2, nc):
+            node = t(nr - 1, j, p)
+            near = hyoid[np.argsort(np.linalg.norm(np.array(b.points)[hyoid] - b.points[node], axis=1))[:2]]
+            for h in near:
+                link(node, int(h), "floor")
+
+    # --- skull points (fixed) ------------------------------------------------------------
+    fixed = []
+
+    def skull(name, key):
+        ids = b.bilateral(name, lm(key))
+        fixed.extend(ids)
+        return ids
+
+    styloid = skull("styloid", "styloid_tip")
+    mastoid = skull("mastoid", "mastoid_notch")
+    temp_a = skull("temporalis_anterior_origin", "temporalis_anterior_origin")
+    temp_p = skull("temporalis_posterior_origin", "temporalis_posterior_origin")
+    masseter = skull("masseter_origin", "masseter_origin")
+    med_pt = skull("medial_pterygoid_origin", "medial_pterygoid_origin")
+    lat_u = skull("lateral_pterygoid_upper_origin", "lateral_pterygoid_upper_origin")
+    lat_l = skull("lateral_pterygoid_lower_origin", "lateral_pterygoid_lower_origin")
+    sternum = skull("sternum", "sternum")
+    thyroid = skull("thyroid", "thyroid")
+    for s in (0, 1):
+        link(sternum[s], (body_l, body_r)[s], "strap")
+        link(thyroid[s], (horn_l, horn_r)[s], "strap")
+
+    # --- muscle routing ------------------------------------------------------------------
+    mid, sides = planes // 2, (0, planes - 1)
+    chain = lambda pts: np.array(pts, dtype=np.int64)  # noqa: E731
+    fib: dict[str, list[np.ndarray]] = {m: [] for m in TONGUE_MUSCLES + JAW_MUSCLES}
+    radial = lambda k, p, j0=0, j1=nc - 1: chain([t(k, j, p) for j in range(j0, j1 + 1)])  # noqa: E731
+    last = nr - 1
+    for k in range(1, 4):
+        fib["GGa"].append(radial(k, mid))
+    for k in range(4, 7):
+        fib["GGm"].append(radial(k, mid))
+    for k in range(7, last + 1):
+        fib["GGp"].append(radial(k, mid))
+    for s, p in enumerate(sides):
+        for h in ((body_l, body_r)[s], (horn_l, horn_r)[s]):
+            for j in (3, 5):
+                fib["HG"].append(chain([h] + [t(k, j, p) for k in range(last, 6, -1)]))
+        fib["SG"].append(chain([styloid[s], t(8, 4, p)] + [t(k, 3, p) for k in range(7, 0, -1)]))
+        fib["SG"].append(chain([styloid[s], t(7, 5, p)] + [t(k, 5, p) for k in range(6, 2, -1)]))
+        fib["IL"].append(chain([t(k, 2, p) for k in range(last - 1, 0, -1)] + [t(0, j, p) for j in range(3, nc)]))
+        fib["MH"].append(chain([myl_front[s], t(last, 1, mid)]))
+        fib["MH"].append(chain([myl_mid[s], t(last, 3, mid)]))
+        fib["MH"].append(chain([myl_back[s], t(last, 5, mid)]))
+        fib["MH"].append(chain([myl_back[s], (body_l, body_r)[s]]))
+        fib["GH"].append(chain([gh_origin, (body_l, body_r)[s]]))
+        fib["temporalis_anterior"].append(chain([temp_a[s], jaw["coronoid"][s]]))
+        fib["temporalis_posterior"].append(chain([temp_p[s], jaw["coronoid"][s]]))
+        fib["masseter"].append(chain([masseter[s], jaw["gonion"][s]]))
+        fib["medial_pterygoid"].append(chain([med_pt[s], jaw["gonion"][s]]))
+        fib["lateral_pterygoid_upper"].append(chain([lat_u[s], jaw["condyle"][s]]))
+        fib["lateral_pterygoid_lower"].append(chain([lat_l[s], jaw["condyle"][s]]))
+        fib["anterior_digastric"].append(chain([dig_fossa[s], (body_l, body_r)[s]]))
+        fib["posterior_digastric"].append(chain([mastoid[s], (body_l, body_r)[s]]))
+    for p in range(planes):
+        fib["SL"].append(chain([t(k, nc - 2, p) for k in range(8, 0, -1)] + [t(0, nc - 1, p)]))
+        if p != mid:
+            for k in range(1, 5):
+                fib["V"].append(chain([t(k, j, p) for j in range(nc - 1, 2, -1)]))
+    for k in range(2, 8):
+        for j in (nc - 3, nc - 2):
+            fib["T"].append(chain([t(k, j, 0), t(k, j, mid), t(k, j, planes - 1)]))
+    for k in range(1, 5):
+        fib["V"].append(chain([t(k, j, mid) for j in range(nc - 1, 2, -1)]))
+
+    nodes = np.array(b.points)
+    weights = {}
+    for m, fs in fib.items():
+        lengths = np.array([np.linalg.norm(np.diff(nodes[f], axis=0), axis=1).sum() for f in fs])
+        weights[m] = np.full(len(fs), 1.0 / len(fs))
+        if not np.all(lengths > 0):
+            raise ArticError(f"muscle {m} has a fibre of zero length; check the landmarks")
+    mandible = np.array(sorted({*[i for v in jaw.values() for i in v], *carried}))
+    sets = dict(mesh.node_sets)
+    sets["jaw"] = np.array([incisor])
+    sets["mandible"] = mandible
+    sets["hyoid"] = hyoid
+    return Body(mesh=mesh, nodes=nodes, names=b.names, links=np.array(links, dtype=np.int64),
+                link_kind=np.array(kinds), fibres=fib, fibre_weight=weights, fixed=np.array(fixed),
+                mandible=mandible, hyoid=hyoid, node_sets=sets)

@@ -1,0 +1,117 @@
+"""Muscles: Hill-type fibres with the paper's force model (Eq. 8-9).
+
+A muscle is a set of parallel fibres; a fibre is a chain of nodes from its
+origin to its insertion and carries one tension along every segment (a
+via-point muscle: a curved fibre also pushes on the nodes it bends around).
+The tension of fibre f with strain e = L/L0 - 1 is
+
+    T_f = s_f u fL(e) / fL(0)                      active (Eq. 9), u in dyn
+        + A_f (k1(e) e + sigma2_f)                 passive parallel spring and Maxwell branch
+
+with fL the fourth-order force-length polynomial of Eq. (9), zero outside
+-0.185 < e < 0.49; k1 = 0.05 k0 e for e > 0 (stretch only); the Maxwell
+branch sigma2' / k2 + sigma2 / b2 = e' with k2 = 2 k0, b2 = b / 10, advanced
+with the implicit step.  ``u`` is the muscle force in newtons at rest length
+(the paper's activation input); s_f the fibre's share of it; A_f the fibre's
+"thickness" (cm^2), which scales the passive parts.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+FL_COEFFS = (22.5, 3.498, -14.718, 1.98, 0.858)  # Eq. (9), highest power first
+FL_RANGE = (-0.185, 0.49)
+
+
+def force_length(strain: np.ndarray) -> np.ndarray:
+    """Eq. (9) normalised to 1 at rest length; zero outside its validity range."""
+    f = np.polyval(FL_COEFFS, strain) / FL_COEFFS[-1]
+    return np.where((strain > FL_RANGE[0]) & (strain < FL_RANGE[1]), np.maximum(f, 0.0), 0.0)
+
+
+@dataclass(frozen=True)
+class MuscleSet:
+    names: tuple[str, ...]
+    seg_i: np.ndarray  # (S,) first node of each segment
+    seg_j: np.ndarray  # (S,)
+    seg_fibre: np.ndarray  # (S,)
+    fibre_muscle: np.ndarray  # (F,)
+    fibre_share: np.ndarray  # (F,) share of the muscle's force
+    fibre_area: np.ndarray  # (F,) thickness, cm^2
+    fibre_l0: np.ndarray  # (F,) rest length, cm
+    k1: float  # passive stiffness coefficient, dyn/cm^2 (k1 = k1 * e)
+    k2: float  # Maxwell spring, dyn/cm^2
+    b2: float  # Maxwell dashpot, dyn s/cm^2
+    diff: sp.csr_matrix  # (S, N) segment vectors
+    seg_sum: sp.csr_matrix  # (F, S) sums segment lengths per fibre
+    scatter: sp.csr_matrix  # (N, S) node force from segment force vectors
+
+    @property
+    def n_fibres(self) -> int:
+        return len(self.fibre_l0)
+
+    def index(self, name: str) -> int:
+        return self.names.index(name)
+
+
+def muscle_set(names, fibres: dict[str, list[np.ndarray]], shares: dict[str, np.ndarray],
+               thickness: dict[str, float], nodes: np.ndarray, k1: float, k2: float, b2: float) -> MuscleSet:
+    seg_i, seg_j, seg_f, f_m, f_share, f_area, f_l0 = [], [], [], [], [], [], []
+    for m, name in enumerate(names):
+        for fibre, share in zip(fibres[name], shares[name]):
+            f = len(f_m)
+            seg_i.extend(fibre[:-1])
+            seg_j.extend(fibre[1:])
+            seg_f.extend([f] * (len(fibre) - 1))
+            f_m.append(m)
+            f_share.append(share)
+            f_area.append(thickness[name] * share)
+            f_l0.append(np.linalg.norm(np.diff(nodes[fibre], axis=0), axis=1).sum())
+    seg_i, seg_j, seg_f = (np.array(a, dtype=np.int64) for a in (seg_i, seg_j, seg_f))
+    s, n = len(seg_i), len(nodes)
+    diff = sp.csr_matrix((np.r_[-np.ones(s), np.ones(s)], (np.r_[np.arange(s), np.arange(s)], np.r_[seg_i, seg_j])),
+                         shape=(s, n))
+    seg_sum = sp.csr_matrix((np.ones(s), (seg_f, np.arange(s))), shape=(len(f_m), s))
+    scatter = sp.csr_matrix((np.r_[np.ones(s), -np.ones(s)], (np.r_[seg_i, seg_j], np.r_[np.arange(s), np.arange(s)])),
+                            shape=(n, s))
+    return MuscleSet(names=tuple(names), seg_i=seg_i, seg_j=seg_j, seg_fibre=seg_f, fibre_muscle=np.array(f_m),
+                     fibre_share=np.array(f_share), fibre_area=np.array(f_area), fibre_l0=np.array(f_l0),
+                     k1=k1, k2=k2, b2=b2, diff=diff, seg_sum=seg_sum, scatter=scatter)
+
+
+@dataclass
+class FibreState:
+    n: np.ndarray  # (S,3) segment unit vectors
+    seg_length: np.ndarray  # (S,)
+    strain: np.ndarray  # (F,)
+    tension: np.ndarray  # (F,) dyn
+    sigma2: np.ndarray  # (F,) Maxwell stress at this state, dyn/cm^2
+
+
+def fibre_state(ms: MuscleSet, x: np.ndarray, activation: np.ndarray, sigma2_prev: np.ndarray,
+                strain_prev: np.ndarray, h: float) -> FibreState:
+    """Tensions for positions ``x``, muscle forces ``activation`` (M,) in dyn, after a step ``h``."""
+    d = ms.diff @ x
+    length = np.sqrt((d * d).sum(axis=1))
+    n = d / length[:, None]
+    strain = (ms.seg_sum @ length) / ms.fibre_l0 - 1.0
+    sigma2 = (sigma2_prev + ms.k2 * (strain - strain_prev)) / (1.0 + h * ms.k2 / ms.b2) if h > 0 else sigma2_prev
+    passive = ms.k1 * np.maximum(strain, 0.0) * strain + sigma2
+    active = activation[ms.fibre_muscle] * ms.fibre_share * force_length(strain)
+    return FibreState(n=n, seg_length=length, strain=strain, tension=active + ms.fibre_area * passive, sigma2=sigma2)
+
+
+def muscle_forces(ms: MuscleSet, fs: FibreState) -> np.ndarray:
+    """(N,3) nodal forces of all fibres."""
+    return ms.scatter @ (fs.tension[ms.seg_fibre][:, None] * fs.n)
+
+
+def muscle_lengths(ms: MuscleSet, x: np.ndarray) -> np.ndarray:
+    """(M,) mean fibre length of each muscle, cm."""
+    d = ms.diff @ x
+    fl = ms.seg_sum @ np.sqrt((d * d).sum(axis=1))
+    return np.bincount(ms.fibre_muscle, weights=fl * ms.fibre_share, minlength=len(ms.names))
