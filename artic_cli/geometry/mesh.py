@@ -121,6 +121,10 @@ def tongue_mesh(geo: TongueGeometry) -> Mesh:
     mid = origin + levels[None, :, None] * (surface[:, None, :] - origin)  # (nr+1, nc+1, 2)
     lateral = origin + (1.0 - geo.parasagittal_shrink) * (mid - origin)
     lateral = lateral - np.array([0.0, geo.parasagittal_drop_cm])
+    # the tip is narrower: the lateral planes recede behind it, most at the surface
+    taper = np.clip(1.0 - np.arange(nr + 1) / max(geo.tip_taper_sections, 1), 0.0, 1.0)
+    depth = (levels - levels[0]) / (levels[-1] - levels[0])
+    lateral[..., 0] -= geo.parasagittal_tip_recess_cm * taper[:, None] * depth[None, :]
     w = geo.half_width_cm
     nodes = np.zeros((nr + 1, nc + 1, PLANES, 3))
     for p, (xy, z) in enumerate([(lateral, -w), (mid, 0.0), (lateral, w)]):

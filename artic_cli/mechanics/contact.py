@@ -116,14 +116,21 @@ def _nearest(cm: ContactModel, p: np.ndarray, tree: cKDTree, tris: np.ndarray):
 
 @dataclass(frozen=True)
 class ContactPlanes:
-    """Per-step linearised wall: node i may not go beyond the plane (q_i, n_i)."""
+    """Per-step linearised wall: node i may not go beyond the plane (q_i, n_i).
+
+    Planes on the mandible translate with the mean of the jaw frame nodes
+    within the step, and the contact force's reaction acts on those nodes."""
 
     nodes: np.ndarray  # (K,)
     q: np.ndarray  # (K,3)
     n: np.ndarray  # (K,3)
+    jaw: np.ndarray  # (K,) bool: plane on the mandible
+    jaw_nodes: np.ndarray  # (J,) frame nodes carrying the mandible's planes
+    jaw_ref: np.ndarray  # (3,) their mean position at the start of the step
 
     def gaps(self, x: np.ndarray) -> np.ndarray:
-        return ((x[self.nodes] - self.q) * self.n).sum(axis=1)
+        shift = np.where(self.jaw[:, None], x[self.jaw_nodes].mean(axis=0) - self.jaw_ref, 0.0)
+        return ((x[self.nodes] - self.q - shift) * self.n).sum(axis=1)
 
 
 def wall_query(cm: ContactModel, x: np.ndarray, nodes: np.ndarray | None = None):
@@ -141,18 +148,19 @@ def wall_query(cm: ContactModel, x: np.ndarray, nodes: np.ndarray | None = None)
     q = np.where(use_jaw[:, None], q2, q1)
     n = np.where(use_jaw[:, None], n2, n1)
     g = np.where(use_jaw, g2, g1)
-    return q, n, g
+    return q, n, g, use_jaw
 
 
 def contact_planes(cm: ContactModel, x: np.ndarray) -> ContactPlanes:
-    q, n, g = wall_query(cm, x)
+    q, n, g, jaw = wall_query(cm, x)
     near = g > -cm.margin
-    return ContactPlanes(nodes=cm.nodes[near], q=q[near], n=n[near])
+    return ContactPlanes(nodes=cm.nodes[near], q=q[near], n=n[near], jaw=jaw[near], jaw_nodes=cm.jaw_nodes,
+                         jaw_ref=x[cm.jaw_nodes].mean(axis=0))
 
 
 def enforce(cm: ContactModel, x: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
     """Project nodes beyond the wall by more than the tolerance back onto it."""
-    q, n, g = wall_query(cm, x)
+    q, n, g, _ = wall_query(cm, x)
     bad = g > cm.tolerance
     if not bad.any():
         return x, v, 0

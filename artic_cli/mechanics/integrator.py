@@ -67,7 +67,11 @@ def contact_forces(model: Model, x: np.ndarray, planes: ContactPlanes | None):
     g = planes.gaps(x)
     active = g > 0
     mag = model.contact.stiffness * np.where(active, g, 0.0)
-    np.add.at(f, planes.nodes, -mag[:, None] * planes.n)
+    push = mag[:, None] * planes.n
+    np.add.at(f, planes.nodes, -push)
+    on_jaw = planes.jaw & active
+    if on_jaw.any():  # the reaction acts on the mandible
+        f[planes.jaw_nodes] += push[on_jaw].sum(axis=0) / len(planes.jaw_nodes)
     return f, active, mag
 
 
@@ -94,10 +98,22 @@ def tangent(model: Model, cs: elements.CylinderState, frame: elements.DampingFra
         idx.append(gd.index)
         val.append(gd.stiffness * np.einsum("gmi,gmj->gij", gd.normals, gd.normals))
     if planes is not None and active.any():
-        pos = np.searchsorted(model.contact.nodes, planes.nodes[active])
-        n = planes.n[active]
-        idx.append(model.contact_index[pos])
-        val.append(model.contact.stiffness * n[:, :, None] * n[:, None, :])
+        k = model.contact.stiffness
+        wall_side = active & ~planes.jaw
+        if wall_side.any():
+            pos = np.searchsorted(model.contact.nodes, planes.nodes[wall_side])
+            n = planes.n[wall_side]
+            idx.append(model.contact_index[pos])
+            val.append(k * n[:, :, None] * n[:, None, :])
+        jaw_side = active & planes.jaw
+        if jaw_side.any():
+            jn = planes.jaw_nodes
+            nodes = np.column_stack([planes.nodes[jaw_side], np.broadcast_to(jn, (jaw_side.sum(), len(jn)))])
+            n = planes.n[jaw_side]
+            vec = np.concatenate([n[:, None, :], np.repeat(-n[:, None, :] / len(jn), len(jn), axis=1)], axis=1)
+            vec = vec.reshape(len(n), -1)
+            idx.append(model.pattern.block_index(nodes))
+            val.append(k * vec[:, :, None] * vec[:, None, :])
     flat_i = np.concatenate([i.ravel() for i in idx])
     flat_v = np.concatenate([v.ravel() for v in val])
     return c_a * model.mass_matrix + model.pattern.assemble(flat_i, flat_v)

@@ -326,7 +326,7 @@ def build_articulator(cfg: Config, mesh: Mesh, wall: WallSurface | None = None, 
     use_contact = cfg.contact.enabled if contact is None else contact
     if use_contact and wall is not None:
         sets = mesh.node_sets
-        nodes = np.unique(np.concatenate([sets["surface"], sets["tip_line"]]))
+        nodes = np.unique(sets["surface"])  # the dorsal surface and the tip (the underside rests on the floor)
         jaw_frame = np.array([body.names[k] for k in ("symphysis_l", "symphysis_r", "coronoid_l", "gonion_r",
                                                       "condyle_l")])
         cm = contact_model(wall, nodes, jaw_frame, body.nodes[jaw_frame],
