@@ -126,8 +126,8 @@ class Jaw(_Strict):
     link_area_cm2: Positive = 0.1
     eminence_slope_deg: Annotated[float, Field(ge=-80, le=0)] = -30.0
     guide_stiffness_n_per_cm: Positive = 1000.0
-    passive_stiffness_n_per_cm: NonNeg = 1.0
-    strap_stiffness_n_per_cm: NonNeg = 2.0
+    passive_stiffness_n_per_cm: NonNeg = 0.5
+    strap_stiffness_n_per_cm: NonNeg = 10.0
     floor_link_area_cm2: Positive = 0.3
 
 

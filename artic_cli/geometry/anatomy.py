@@ -148,6 +148,7 @@ def build_body(cfg: Config, mesh: Mesh | None = None) -> Body:
     med_pt = skull("medial_pterygoid_origin", "medial_pterygoid_origin")
     lat_u = skull("lateral_pterygoid_upper_origin", "lateral_pterygoid_upper_origin")
     lat_l = skull("lateral_pterygoid_lower_origin", "lateral_pterygoid_lower_origin")
+    sling = skull("digastric_sling", "hyoid_body_end")  # the digastric tendon's fixed pulley (paper III.A)
     sternum = skull("sternum", "sternum")
     thyroid = skull("thyroid", "thyroid")
     for s in (0, 1):
@@ -184,7 +185,7 @@ def build_body(cfg: Config, mesh: Mesh | None = None) -> Body:
         fib["medial_pterygoid"].append(chain([med_pt[s], jaw["gonion"][s]]))
         fib["lateral_pterygoid_upper"].append(chain([lat_u[s], jaw["condyle"][s]]))
         fib["lateral_pterygoid_lower"].append(chain([lat_l[s], jaw["condyle"][s]]))
-        fib["anterior_digastric"].append(chain([dig_fossa[s], (body_l, body_r)[s]]))
+        fib["anterior_digastric"].append(chain([dig_fossa[s], sling[s]]))
         fib["posterior_digastric"].append(chain([mastoid[s], (body_l, body_r)[s]]))
     for p in range(planes):
         fib["SL"].append(chain([t(k, nc - 2, p) for k in range(8, 0, -1)] + [t(0, nc - 1, p)]))
