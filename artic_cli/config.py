@@ -37,7 +37,7 @@ class TongueGeometry(_Strict):
     half_width_cm: Positive = 1.0
     parasagittal_shrink: Annotated[float, Field(ge=0, lt=0.5)] = 0.08
     parasagittal_drop_cm: float = 0.15
-    parasagittal_tip_recess_cm: NonNeg = 0.6
+    parasagittal_tip_recess_cm: NonNeg = 0.0
     tip_taper_sections: Annotated[int, Field(ge=1, le=20)] = 3
     radial_sections: Annotated[int, Field(ge=2, le=40)] = 10
     concentric_sections: Annotated[int, Field(ge=2, le=20)] = 6

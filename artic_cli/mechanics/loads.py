@@ -1,4 +1,4 @@
-"""External loads on named node sets, switched on and off in time."""
+"""External loads on named node sets and muscle forces, switched on and off in time."""
 
 from __future__ import annotations
 
@@ -7,29 +7,59 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import units
+from ..errors import ArticError
 from ..schedule import Schedule
 from .model import Control, Model
 
 
 @dataclass(frozen=True)
 class LoadProgram:
-    """Piecewise-constant nodal forces: entry k acts on ``nodes[k]`` in [on, off)."""
+    """Piecewise-constant inputs: load k acts on ``nodes[k]`` in [on, off); muscle entry m adds
+    ``muscle_force[m] * muscle_share[m]`` to the activations in [m_on, m_off)."""
 
     nodes: tuple[np.ndarray, ...]
     force: np.ndarray  # (K,3) per-node force, dyn
     on: np.ndarray  # (K,) s
     off: np.ndarray  # (K,) s
     n_nodes: int
+    muscle_share: np.ndarray  # (E, M) how each muscle entry spreads over the model's muscles
+    muscle_force: np.ndarray  # (E,) dyn
+    m_on: np.ndarray
+    m_off: np.ndarray
 
     def control_at(self, t: float) -> Control:
         f = np.zeros((self.n_nodes, 3))
         eps = 1e-12
         for k in np.flatnonzero((self.on <= t + eps) & (t + eps < self.off)):
             np.add.at(f, self.nodes[k], self.force[k])
-        return Control(force=f)
+        live = (self.m_on <= t + eps) & (t + eps < self.m_off)
+        act = (self.muscle_force * live) @ self.muscle_share if len(self.muscle_force) else self.muscle_share.sum(0)
+        return Control(force=f, activation=act)
 
 
-def load_program(model: Model, schedule: Schedule) -> LoadProgram:
+def activation_vector(model: Model, forces_n: dict[str, float]) -> np.ndarray:
+    """Muscle activations (dyn) from {muscle or group: force in N}."""
+    act = np.zeros(len(model.muscle_names))
+    for name, fn in forces_n.items():
+        act += units.newton_to_dyn(fn) * muscle_shares(model, name)
+    return act
+
+
+def muscle_shares(model: Model, name: str) -> np.ndarray:
+    share = np.zeros(len(model.muscle_names))
+    if name in model.groups:
+        for m, w in model.groups[name].items():
+            share[model.muscle_names.index(m)] += w
+    else:
+        share[model.muscle_names.index(name)] = 1.0
+    return share
+
+
+def load_program(model: Model, schedule: Schedule, source: str = "schedule") -> LoadProgram:
+    if schedule.muscles:
+        if model.muscles is None:
+            raise ArticError(f"{source}: muscles need the whole articulator; drop --tongue-only")
+        schedule.check_muscles(model.drivable(), source)
     nodes, force, on, off = [], [], [], []
     for e in schedule.loads:
         idx = model.node_set(e.nodes)
@@ -37,5 +67,12 @@ def load_program(model: Model, schedule: Schedule) -> LoadProgram:
         force.append(units.newton_to_dyn(np.asarray(e.force_n, dtype=float)) / len(idx))
         on.append(units.ms_to_s(e.onset_ms))
         off.append(units.ms_to_s(e.onset_ms + e.duration_ms))
+    m = len(model.muscle_names)
+    share = np.zeros((len(schedule.muscles), m))
+    for k, e in enumerate(schedule.muscles):
+        share[k] = muscle_shares(model, e.muscle)
     return LoadProgram(nodes=tuple(nodes), force=np.array(force).reshape(-1, 3), on=np.array(on),
-                       off=np.array(off), n_nodes=model.n_nodes)
+                       off=np.array(off), n_nodes=model.n_nodes, muscle_share=share,
+                       muscle_force=np.array([units.newton_to_dyn(e.force_n) for e in schedule.muscles]),
+                       m_on=np.array([units.ms_to_s(e.onset_ms) for e in schedule.muscles]),
+                       m_off=np.array([units.ms_to_s(e.onset_ms + e.duration_ms) for e in schedule.muscles]))

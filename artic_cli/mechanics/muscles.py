@@ -115,3 +115,12 @@ def muscle_lengths(ms: MuscleSet, x: np.ndarray) -> np.ndarray:
     d = ms.diff @ x
     fl = ms.seg_sum @ np.sqrt((d * d).sum(axis=1))
     return np.bincount(ms.fibre_muscle, weights=fl * ms.fibre_share, minlength=len(ms.names))
+
+
+def muscle_tensions(ms: MuscleSet, x: np.ndarray, activation: np.ndarray, sigma2: np.ndarray) -> np.ndarray:
+    """(M,) total force of each muscle (sum over its fibres), dyn, with the Maxwell state given."""
+    d = ms.diff @ x
+    strain = (ms.seg_sum @ np.sqrt((d * d).sum(axis=1))) / ms.fibre_l0 - 1.0
+    passive = ms.k1 * np.maximum(strain, 0.0) * strain + sigma2
+    t = activation[ms.fibre_muscle] * ms.fibre_share * force_length(strain) + ms.fibre_area * passive
+    return np.bincount(ms.fibre_muscle, weights=t, minlength=len(ms.names))

@@ -11,7 +11,8 @@ import numpy as np
 from ..geometry.hexahedra import corner_jacobians, volumes
 from .elements import strain_energy
 from .integrator import step
-from .model import Control, Model, State, with_options
+from .model import Control, Model, State, rest_state, with_options, zero_control
+from .muscles import muscle_lengths, muscle_tensions
 from .volume import volume_energy
 
 
@@ -26,6 +27,13 @@ class Trajectory:
     work: np.ndarray  # (T,) work done by external loads and gravity since t0, erg
     inverted: np.ndarray  # (T,) number of bricks turned inside out
     stats: dict = field(default_factory=dict)
+    muscle_force: np.ndarray | None = None  # (T,M) dyn
+    muscle_length: np.ndarray | None = None  # (T,M) cm
+    contact_count: np.ndarray | None = None  # (T,) nodes in contact after the step
+    contact_total: np.ndarray | None = None  # (T,) total contact force, dyn
+    contact_nodes: list = field(default_factory=list)  # per frame: node ids
+    contact_forces: list = field(default_factory=list)  # per frame: dyn
+    projected: np.ndarray | None = None  # (T,) nodes projected back onto the wall
 
     @property
     def volume_change(self) -> np.ndarray:
@@ -67,6 +75,17 @@ def run(model: Model, state: State, control_at: Callable[[float], Control], dura
     n_steps = max(1, int(round(duration / h)))
     times, xs, vs, its = [state.t], [state.x.copy()], [state.v.copy()], [0]
     work = [0.0]
+    ms = model.muscles
+    m_force, m_len = [], []
+    c_nodes, c_forces, proj = [state.contact_nodes], [state.contact_force], [0]
+
+    def record_muscles(st: State, act) -> None:
+        if ms is not None:
+            a = act if act is not None else np.zeros(len(ms.names))
+            m_force.append(muscle_tensions(ms, st.x, a, st.sigma2))
+            m_len.append(muscle_lengths(ms, st.x))
+
+    record_muscles(state, control_at(state.t).activation if ms is not None else None)
     w = 0.0
     gravity = model.node_mass[:, None] * model.gravity
     t0 = time.perf_counter()
@@ -82,6 +101,10 @@ def run(model: Model, state: State, control_at: Callable[[float], Control], dura
             vs.append(state.v.copy())
             its.append(state.iterations)
             work.append(w)
+            record_muscles(state, ctl.activation)
+            c_nodes.append(state.contact_nodes)
+            c_forces.append(state.contact_force)
+            proj.append(state.projected)
         if progress is not None:
             progress(k, n_steps)
     wall = time.perf_counter() - t0
@@ -93,7 +116,13 @@ def run(model: Model, state: State, control_at: Callable[[float], Control], dura
                       energy=energy - energy[0], work=np.array(work), inverted=inv,
                       stats={"steps": n_steps, "dt": h, "wall_time_s": wall, "refactors": state.refactors,
                              "newton_iterations": int(np.sum(its)),
-                             "diagnostics_time_s": time.perf_counter() - t0 - wall})
+                             "diagnostics_time_s": time.perf_counter() - t0 - wall},
+                      contact_count=np.array([len(c) for c in c_nodes]),
+                      contact_total=np.array([float(np.sum(c)) for c in c_forces]),
+                      contact_nodes=c_nodes, contact_forces=c_forces, projected=np.array(proj))
+    if ms is not None:
+        traj.muscle_force = np.array(m_force)
+        traj.muscle_length = np.array(m_len)
     return traj, state
 
 
@@ -110,3 +139,9 @@ def equilibrate(model: Model, state: State, control: Control, dt: float = 0.01, 
         if np.abs(state.v).max() < tol:
             return state, True
     return state, False
+
+
+def settle(model: Model, max_time: float = 5.0) -> State:
+    """The rest posture: equilibrium under gravity with every muscle at zero force (t = 0)."""
+    state, _ = equilibrate(model, rest_state(model), zero_control(model), dt=0.01, tol=1e-2, max_time=max_time)
+    return State(t=0.0, x=state.x, v=np.zeros_like(state.v), sigma2=state.sigma2, fibre_strain=state.fibre_strain)
