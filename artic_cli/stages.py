@@ -20,8 +20,8 @@ from .geometry.mesh import tongue_mesh
 from .geometry.wall import wall_surface
 from .io.store import atomic_h5, file_hash, load_mesh, save_mesh
 from .mechanics.loads import load_program
-from .mechanics.model import Model, build_model, rest_state
-from .mechanics.simulate import Trajectory, run
+from .mechanics.model import Model, build_articulator, build_model, rest_state
+from .mechanics.simulate import Trajectory, run, settle
 from .schedule import load_schedule
 
 
@@ -50,11 +50,15 @@ def build_mesh(config: Path | str | None = None, out: Path | str = "data/mesh.h5
                        mesh.cylinder_volume, len(wall.triangles))
 
 
-def load_model(mesh_path: Path | str, config: Path | str | None = None,
-               volume_constraint: bool | None = None) -> tuple[Model, Config, object]:
+def load_model(mesh_path: Path | str, config: Path | str | None = None, volume_constraint: bool | None = None,
+               tongue_only: bool = False, contact: bool | None = None) -> tuple[Model, Config, object]:
+    """The whole articulator (or the tongue alone, its listed node sets held) from a mesh file."""
     cfg = load_config(config)
     mesh, wall, _ = load_mesh(mesh_path, expect=cfg)
-    model = build_model(mesh, cfg.materials.tongue, cfg.simulation, volume_constraint=volume_constraint)
+    if tongue_only:
+        model = build_model(mesh, cfg.materials.tongue, cfg.simulation, volume_constraint=volume_constraint)
+    else:
+        model = build_articulator(cfg, mesh, wall, volume_constraint=volume_constraint, contact=contact)
     return model, cfg, wall
 
 
@@ -74,8 +78,9 @@ class SimResult:
 def simulate(schedule: Path | str, duration: float | None = None, dt: float | None = None,
              mesh: Path | str = "data/mesh.h5", config: Path | str | None = None, out: Path | str | None = None,
              volume_constraint: bool | None = None, plot: Path | str | None = None,
-             progress: Callable[[int, int], None] | None = None) -> SimResult:
-    """Run the tissue model under a load schedule; write ``out`` (HDF5)."""
+             progress: Callable[[int, int], None] | None = None, tongue_only: bool = False,
+             contact: bool | None = None) -> SimResult:
+    """Run the model under a schedule of muscle forces and loads from its rest posture; write ``out`` (HDF5)."""
     _positive("--duration", duration)
     _positive("--dt", dt)
     sched = load_schedule(schedule)
@@ -84,12 +89,13 @@ def simulate(schedule: Path | str, duration: float | None = None, dt: float | No
             raise ArticError(f"{schedule}: no duration; give --duration S or 'duration_ms' in the schedule")
         duration = units.ms_to_s(sched.duration_ms)
     sched.check_duration(units.s_to_ms(duration), str(schedule))
-    model, cfg, wall = load_model(mesh, config, volume_constraint)
+    model, cfg, wall = load_model(mesh, config, volume_constraint, tongue_only, contact)
     h = model.options.dt if dt is None else dt
     if h > duration:
         raise ArticError(f"--dt {h:g} s is longer than the run ({duration:g} s); give a smaller --dt")
-    program = load_program(model, sched)
-    traj, _ = run(model, rest_state(model), program.control_at, duration, h,
+    program = load_program(model, sched, str(schedule))
+    start = rest_state(model) if tongue_only else settle(model)
+    traj, _ = run(model, start, program.control_at, duration, h,
                   record_every=cfg.simulation.record_every, progress=progress)
     out = Path(out) if out is not None else Path("data/sims") / f"{Path(schedule).stem}.h5"
     write_trajectory(out, traj, model, cfg, inputs={"mesh": file_hash(mesh), "schedule": file_hash(schedule)},
@@ -102,7 +108,8 @@ def simulate(schedule: Path | str, duration: float | None = None, dt: float | No
 
 
 def control_point_indices(model: Model) -> dict[str, int]:
-    return {name: int(model.mesh.node_sets[name][0]) for name in ("tip", "dorsum") if name in model.mesh.node_sets}
+    """Tongue tip, dorsum (fifth midsagittal surface node from the tip) and jaw (lower incisor)."""
+    return {name: int(model.node_sets[name][0]) for name in ("tip", "dorsum", "jaw") if name in model.node_sets}
 
 
 def write_trajectory(path: Path, traj: Trajectory, model: Model, cfg: Config, inputs: dict, extra: dict) -> None:
@@ -133,3 +140,17 @@ def write_trajectory(path: Path, traj: Trajectory, model: Model, cfg: Config, in
         f.create_dataset("work", data=units.erg_to_joule(traj.work)).attrs["units"] = "J (external loads + gravity)"
         f.create_dataset("inverted_bricks", data=traj.inverted)
         f.create_dataset("newton_iterations", data=traj.iterations)
+        if traj.muscle_force is not None:
+            g = f.create_group("muscles")
+            g.attrs["names"] = list(model.muscle_names)
+            g.create_dataset("force", data=units.dyn_to_newton(traj.muscle_force)).attrs["units"] = "N"
+            g.create_dataset("length", data=traj.muscle_length).attrs["units"] = "cm"
+        if traj.contact_count is not None:
+            g = f.create_group("contacts")
+            g.create_dataset("count", data=traj.contact_count)
+            g.create_dataset("total_force", data=units.dyn_to_newton(traj.contact_total)).attrs["units"] = "N"
+            g.create_dataset("projected", data=traj.projected)
+            g.create_dataset("offsets", data=np.cumsum([0] + [len(c) for c in traj.contact_nodes]))
+            g.create_dataset("nodes", data=np.concatenate(traj.contact_nodes).astype(np.int64))
+            g.create_dataset("force", data=units.dyn_to_newton(np.concatenate(traj.contact_forces))).attrs["units"] = "N"
+            g.attrs["layout"] = "frame k: nodes[offsets[k]:offsets[k+1]] with force[...] (N)"

@@ -89,16 +89,19 @@ def simulate_cmd(
     volume_constraint: Optional[bool] = typer.Option(None, "--volume-constraint/--no-volume-constraint",
                                                      help="Override the config's volume constraint."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Draw start and end shapes (PNG)."),
+    tongue_only: bool = typer.Option(False, "--tongue-only", help="The tongue alone, its fixed node sets held."),
+    contact: Optional[bool] = typer.Option(None, "--contact/--no-contact", help="Override the config's wall contact."),
 ):
-    """Run the tissue model under a schedule of loads; write trajectories and volume."""
+    """Move the model under a schedule of muscle forces and loads; write trajectories."""
     from ..stages import simulate
 
     bar, update = _progress("simulating")
+    args = (schedule, duration, dt, mesh, config, out, volume_constraint, plot)
     if bar is not None:
         with bar:
-            r = simulate(schedule, duration, dt, mesh, config, out, volume_constraint, plot, update)
+            r = simulate(*args, update, tongue_only=tongue_only, contact=contact)
     else:
-        r = simulate(schedule, duration, dt, mesh, config, out, volume_constraint, plot)
+        r = simulate(*args, tongue_only=tongue_only, contact=contact)
     t = r.trajectory
     sim_time = t.time[-1] - t.time[0]
     out_console.print(
@@ -143,6 +146,33 @@ def validate_cuboid_cmd(
         table.add_row(f"{r.force_n:g}", f"{r.axial_strain:.4f}", f"{r.lateral_strain:.4f}", f"{r.poisson_ratio:.3f}",
                       f"{r.poisson_ratio_log:.3f}", f"{100 * r.volume_change:+.3f} %", f"{r.elongation_cm:.4f}",
                       f"{r.linear_elongation_cm:.4f}", "yes" if r.converged else "NO")
+    out_console.print(table)
+
+
+@app.command("experiment")
+@handle_errors
+def experiment_cmd(
+    name: str = typer.Argument(..., help="jaw-ep, fig4, muscle-directions, k-closure or stress."),
+    mesh: Path = typer.Option(Path("data/mesh.h5"), "--mesh", help="Mesh artefact from build-mesh."),
+    config: Optional[Path] = typer.Option(None, "--config", help="Config the mesh was built from."),
+    as_json: bool = typer.Option(False, "--json", help="Print the table as JSON."),
+):
+    """Reproduce one of the paper's numeric experiments, ours beside the paper's."""
+    from ..experiments.paper import EXPERIMENTS, rows_as_dicts
+    from ..stages import load_model
+
+    if name not in EXPERIMENTS:
+        raise ArticError(f"unknown experiment '{name}'; valid: {', '.join(EXPERIMENTS)}")
+    model, _, _ = load_model(mesh, config)
+    rows = EXPERIMENTS[name](model)
+    if as_json:
+        out_console.print_json(json.dumps(rows_as_dicts(rows)))
+        return
+    table = Table(title=f"experiment {name}: ours beside Dang & Honda (2004)")
+    for col in ("quantity", "ours", "paper", "unit", "note"):
+        table.add_column(col, justify="left" if col in ("quantity", "note") else "right")
+    for r in rows:
+        table.add_row(r.name, f"{r.ours:.3g}", "" if r.paper is None else f"{r.paper:g}", r.unit, r.note)
     out_console.print(table)
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import matplotlib.pyplot as plt
+import numpy as np
 
 from .common import draw_tongue, draw_wall, finish_axes, save_figure
 
@@ -13,11 +14,20 @@ def plot_simulation(traj, model, wall, path: Path | str, title: str = "") -> Pat
     fig, ax = plt.subplots(figsize=(7.5, 7.5))
     draw_wall(ax, wall, lateral=False)
     grid = model.mesh.grid
-    draw_tongue(ax, traj.x[0], grid, color="#999999", label="start", lateral=False)
-    draw_tongue(ax, traj.x[-1], grid, color="#c0392b", label=f"end ({traj.time[-1] * 1e3:.0f} ms)", lateral=False)
-    for name, marker in (("tip", "o"), ("dorsum", "s")):
-        if name in model.mesh.node_sets:
-            i = model.mesh.node_sets[name][0]
+    nt = model.n_tongue
+    draw_tongue(ax, traj.x[0, :nt], grid, color="#999999", label="start", lateral=False)
+    draw_tongue(ax, traj.x[-1, :nt], grid, color="#c0392b", label=f"end ({traj.time[-1] * 1e3:.0f} ms)", lateral=False)
+    if model.n_nodes > nt:  # jaw and hyoid links (left side) at start and end
+        bones = np.concatenate([model.node_sets.get("mandible", []), model.node_sets.get("hyoid", [])])
+        pairs = np.column_stack([model.cyl.i, model.cyl.j])
+        pairs = pairs[np.isin(pairs, bones).all(axis=1) & (model.rest[pairs][:, :, 2] >= 0).all(axis=1)]
+        for frame, colour, label in ((0, "#999999", "jaw and hyoid, start"), (-1, "#1f4e79", "jaw and hyoid, end")):
+            for k, (a, b) in enumerate(pairs):
+                xy = traj.x[frame][[a, b]]
+                ax.plot(xy[:, 0], xy[:, 1], color=colour, lw=1.0, label=label if k == 0 else None)
+    for name, marker in (("tip", "o"), ("dorsum", "s"), ("jaw", "^")):
+        if name in model.node_sets:
+            i = model.node_sets[name][0]
             ax.plot(traj.x[:, i, 0], traj.x[:, i, 1], "-", lw=1.2, marker=marker, ms=2,
                     label=f"{name} path")
     finish_axes(ax, title)

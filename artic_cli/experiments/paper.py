@@ -1,0 +1,144 @@
+"""The paper's numeric experiments (section III), each beside the paper's figure.
+
+Every experiment starts from the rest posture (equilibrium under gravity,
+no muscle force) of the whole articulator and returns rows of plain numbers
+(cm, cm/s, N), so that the CLI can print them and tests can check them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from .. import units
+from ..mechanics.loads import activation_vector
+from ..mechanics.model import Control, Model
+from ..mechanics.simulate import run, settle
+
+PAPER_JAW_EP = {"JO": ((0.5, -0.16), (1.2, -0.37), (2.5, -0.76), (4.0, -1.10), (6.0, -1.42)),
+                "JC": ((0.5, 0.09), (1.5, 0.21), (3.0, 0.47))}
+PAPER_FIG4_SG = {"tip": 41.0, "dorsum": 30.0, "jaw": 8.0}  # Table II, cm/s
+# Section IV.A.1: definite directions (unit vectors in x, y) of the tip and dorsum for each muscle
+_D = {"up": (0, 1), "down": (0, -1), "back": (-1, 0), "front": (1, 0)}
+
+
+def _dir(*words: str) -> tuple[float, float]:
+    v = np.sum([_D[w] for w in words], axis=0).astype(float)
+    return tuple(v / np.linalg.norm(v))
+
+
+PAPER_DIRECTIONS = {
+    "GGa": {"tip": _dir("down")},
+    "GGm": {"tip": _dir("front", "down"), "dorsum": _dir("front", "down")},
+    "GGp": {"tip": _dir("front", "up"), "dorsum": _dir("front", "up")},
+    "HG": {"tip": _dir("back"), "dorsum": _dir("back", "down")},
+    "SG": {"tip": _dir("back"), "dorsum": _dir("back", "up")},
+    "IL": {"tip": _dir("back", "down"), "dorsum": _dir("back", "up")},
+    "SL": {"tip": _dir("up", "back"), "dorsum": _dir("back", "down")},
+    "V": {"tip": _dir("down"), "dorsum": _dir("down", "front")},
+    "MH": {"dorsum": _dir("up", "front")},
+}
+
+
+@dataclass
+class Row:
+    name: str
+    ours: float
+    paper: float | None
+    unit: str
+    note: str = ""
+
+
+def _control(model: Model, forces_n: dict[str, float]) -> Control:
+    return Control(force=np.zeros((model.n_nodes, 3)), activation=activation_vector(model, forces_n))
+
+
+def _points(model: Model) -> dict[str, int]:
+    return {k: int(model.node_sets[k][0]) for k in ("tip", "dorsum", "jaw")}
+
+
+def jaw_ep(model: Model, duration: float = 0.3) -> list[Row]:
+    rest = settle(model)
+    jaw = _points(model)["jaw"]
+    rows = []
+    for group, pairs in PAPER_JAW_EP.items():
+        for force, paper in pairs:
+            ctl = _control(model, {group: force})
+            _, end = run(model, rest, lambda t: ctl, duration)
+            rows.append(Row(f"{group} {force:g} N", float(end.x[jaw, 1] - rest.x[jaw, 1]), paper, "cm",
+                            f"residual speed {np.linalg.norm(end.v[jaw]):.2f} cm/s"))
+    return rows
+
+
+def fig4(model: Model) -> list[Row]:
+    rest = settle(model)
+    pts = _points(model)
+    rows = []
+    for muscle in ("GGp", "SG"):
+        ctl = _control(model, {muscle: 4.0, "JO": 3.0})
+        traj, _ = run(model, rest, lambda t: ctl, 0.02)
+        for name, i in pts.items():
+            disp = float(np.linalg.norm(traj.x[-1, i, :2] - traj.x[0, i, :2]))
+            speed = float(np.linalg.norm(traj.v[:, i, :2], axis=1).max())
+            paper = PAPER_FIG4_SG[name] if muscle == "SG" else None
+            rows.append(Row(f"{muscle}+JO {name} displacement", disp, None, "cm"))
+            rows.append(Row(f"{muscle}+JO {name} peak speed", speed, paper, "cm/s"))
+    return rows
+
+
+def muscle_directions(model: Model, force: float = 4.0, duration: float = 0.3) -> list[Row]:
+    rest = settle(model)
+    pts = _points(model)
+    rows = []
+    for muscle in ("GGa", "GGm", "GGp", "HG", "SG", "SL", "IL", "T", "V", "GH", "MH", "T-SL"):
+        ctl = _control(model, {muscle: force})
+        _, end = run(model, rest, lambda t: ctl, duration)
+        for cp in ("tip", "dorsum"):
+            d = end.x[pts[cp], :2] - rest.x[pts[cp], :2]
+            paper = PAPER_DIRECTIONS.get(muscle, {}).get(cp)
+            angle = float(np.degrees(np.arctan2(d[1], d[0])))
+            err = None
+            if paper is not None:
+                cosang = np.dot(d, paper) / max(np.linalg.norm(d), 1e-12)
+                err = float(np.degrees(np.arccos(np.clip(cosang, -1, 1))))
+            rows.append(Row(f"{muscle} {cp}", float(np.linalg.norm(d)), None, "cm",
+                            f"direction {angle:+.0f} deg" + (f", {err:.0f} deg from the paper's" if err is not None
+                                                             else ", paper: no definite direction")))
+    return rows
+
+
+def k_closure(model: Model, forces=(0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0, 4.0), duration: float = 0.3) -> list[Row]:
+    """Smallest SG force at which the dorsum region touches the palate (jaw at rest)."""
+    rest = settle(model)
+    dorsum_region = set(model.node_sets["dorsum_region"].tolist())
+    found = None
+    for force in forces:
+        ctl = _control(model, {"SG": force})
+        traj, _ = run(model, rest, lambda t: ctl, duration)
+        if any(dorsum_region & set(c.tolist()) for c in traj.contact_nodes):
+            found = force
+            break
+    return [Row("SG force at first dorsum-palate contact", float("nan") if found is None else found, 1.0, "N",
+                "" if found is not None else f"no contact up to {forces[-1]:g} N")]
+
+
+def stress(model: Model, force: float = 7.0, duration: float = 0.5) -> list[Row]:
+    rest = settle(model)
+    ctl = _control(model, {m: force for m in ("GGp", "SG", "HG", "SL", "IL")})
+    traj, _ = run(model, rest, lambda t: ctl, duration)
+    return [Row("finite positions", float(np.isfinite(traj.x).all()), 1.0, "bool"),
+            Row("inverted bricks (max)", float(traj.inverted.max()), 0.0, "count"),
+            Row("volume change (max)", float(100 * np.abs(traj.volume_change).max()), 0.3, "%"),
+            Row("nodes projected back onto the wall", float(traj.projected.sum()), None, "count")]
+
+
+EXPERIMENTS = {"jaw-ep": jaw_ep, "fig4": fig4, "muscle-directions": muscle_directions, "k-closure": k_closure,
+               "stress": stress}
+
+
+def rows_as_dicts(rows: list[Row]) -> list[dict]:
+    return [asdict(r) for r in rows]
+
+
+__all__ = ["EXPERIMENTS", "Row", "rows_as_dicts", "units"]
