@@ -1,0 +1,127 @@
+"""The whole articulator: muscles, jaw and hyoid, contact (work in progress on issue 3)."""
+
+import numpy as np
+import pytest
+
+from artic_cli.errors import ArticError
+from artic_cli.experiments.paper import PAPER_DIRECTIONS, jaw_ep, muscle_directions
+from artic_cli.mechanics.contact import wall_query
+from artic_cli.mechanics.loads import activation_vector
+from artic_cli.mechanics.model import Control, build_articulator
+from artic_cli.mechanics.muscles import FL_RANGE, force_length
+from artic_cli.mechanics.simulate import run, settle
+from artic_cli.schedule import parse_schedule
+
+
+@pytest.fixture(scope="module")
+def art(cfg, mesh, wall):
+    return build_articulator(cfg, mesh, wall)
+
+
+@pytest.fixture(scope="module")
+def rest(art):
+    return settle(art)
+
+
+def test_force_length_is_eq9_normalised_and_zero_outside_its_range():
+    assert force_length(np.array([0.0]))[0] == pytest.approx(1.0)
+    e = np.array([FL_RANGE[0] - 0.01, FL_RANGE[1] + 0.01, -0.3, 0.6])
+    assert (force_length(e) == 0).all()
+    inside = np.linspace(FL_RANGE[0] + 0.02, 0.45, 50)  # the polynomial reaches zero near 0.47
+    assert (force_length(inside) > 0).all()
+    assert force_length(np.array([0.06]))[0] > 1.0  # the optimum lies just beyond rest length
+
+
+def test_body_has_the_paper_structure(art):
+    assert len(art.muscle_names) == 19  # 11 tongue muscles + 8 jaw/hyoid units
+    assert set(art.groups) >= {"JO", "JC", "T-SL"}
+    mandible = art.node_sets["mandible"]
+    bone_mass = art.node_mass[np.concatenate([mandible, art.node_sets["hyoid"]])].sum()
+    assert bone_mass == pytest.approx(155.0, rel=1e-9)  # 150 g mandible + 5 g hyoid
+    # symmetric left-right
+    z = art.rest[:, 2]
+    assert np.allclose(np.sort(z), np.sort(-z))
+
+
+def test_rest_posture_is_an_upright_equilibrium_inside_the_wall(art, rest):
+    assert np.abs(rest.v).max() < 0.05
+    from artic_cli.geometry.hexahedra import inverted_bricks
+
+    assert len(inverted_bricks(rest.x, art.bricks)) == 0
+    _, _, gap, _ = wall_query(art.contact, rest.x)
+    assert gap.max() <= art.contact.tolerance
+
+
+def test_a_strong_muscle_keeps_volume_and_stays_inside_the_wall(art, rest):
+    ctl = Control(force=np.zeros((art.n_nodes, 3)), activation=activation_vector(art, {"SG": 4.0, "GGp": 2.0}))
+    traj, end = run(art, rest, lambda t: ctl, 0.2)
+    assert np.isfinite(traj.x).all() and traj.inverted.max() == 0
+    assert np.abs(traj.volume_change).max() <= 0.003
+    for x in traj.x[::5]:
+        assert wall_query(art.contact, x)[2].max() <= art.contact.tolerance + 1e-12
+
+
+def test_schedule_muscles_are_checked(art):
+    s = parse_schedule({"muscles": [{"muscle": "GGz", "force_n": 1, "duration_ms": 10}]})
+    with pytest.raises(ArticError, match="unknown; valid: GGa, GGm"):
+        s.check_muscles(art.drivable())
+    s = parse_schedule({"muscles": [{"muscle": "SG", "force_n": 1, "onset_ms": 0, "duration_ms": 100},
+                                    {"muscle": "SG", "force_n": 2, "onset_ms": 50, "duration_ms": 100}]})
+    with pytest.raises(ArticError, match="overlap"):
+        s.check_muscles(art.drivable())
+    with pytest.raises(ArticError, match="force_n"):
+        parse_schedule({"muscles": [{"muscle": "SG", "force_n": -1, "duration_ms": 10}]})
+
+
+@pytest.fixture(scope="module")
+def jaw_rows(art):
+    return jaw_ep(art)
+
+
+def test_jaw_equilibria_move_monotonically_with_force(jaw_rows):
+    jo = [r.ours for r in jaw_rows if r.name.startswith("JO")]
+    jc = [r.ours for r in jaw_rows if r.name.startswith("JC")]
+    assert all(b < a for a, b in zip(jo, jo[1:])) and jo[0] < 0
+    assert all(b > a for a, b in zip(jc, jc[1:])) and jc[0] > 0
+
+
+@pytest.mark.xfail(strict=True, reason="known difference (issue 3 open): wide jaw openings fall short of the "
+                   "paper (JO 6 N: -0.67 vs -1.42 cm); the openers' force-length curve collapses as they shorten")
+def test_jaw_equilibria_within_a_factor_of_two_of_the_paper(jaw_rows):
+    for r in jaw_rows:
+        assert 0.5 <= r.ours / r.paper <= 2.0, r
+
+
+@pytest.fixture(scope="module")
+def directions(art):
+    return {r.name: r for r in muscle_directions(art)}
+
+
+AGREE = [("GGm", "dorsum"), ("GGp", "tip"), ("GGp", "dorsum"), ("HG", "tip"), ("HG", "dorsum"), ("SG", "tip"),
+         ("SG", "dorsum"), ("SL", "tip"), ("SL", "dorsum"), ("V", "dorsum")]
+KNOWN = {("GGa", "tip"): "our GGa lines end on the blade behind a blunt 2-cm-wide tip, which bulges forward",
+         ("GGm", "tip"): "the same blade bulging moves the tip forward-up, not forward-down",
+         ("IL", "tip"): "our IL follows a deep arc around the GG origin; its pull on the tip is weak and downward",
+         ("IL", "dorsum"): "the deep IL arc pulls the dorsum toward the origin (down)",
+         ("V", "tip"): "V flattens the blade; the tip moves forward rather than down",
+         ("MH", "dorsum"): "the floor lifts the dorsum forward more than up"}
+
+
+def _angle(row) -> float:
+    return float(row.note.split(",")[1].split("deg")[0])
+
+
+@pytest.mark.parametrize("muscle,cp", AGREE)
+def test_muscle_moves_its_control_point_the_paper_s_way(directions, muscle, cp):
+    assert _angle(directions[f"{muscle} {cp}"]) <= 45.0
+
+
+@pytest.mark.parametrize("muscle,cp", sorted(KNOWN))
+def test_known_direction_differences(directions, muscle, cp, request):
+    request.node.add_marker(pytest.mark.xfail(strict=True, reason=f"known difference (issue 3 open): {KNOWN[(muscle, cp)]}"))
+    assert _angle(directions[f"{muscle} {cp}"]) <= 45.0
+
+
+def test_every_definite_direction_is_tested():
+    listed = {(m, c) for m, d in PAPER_DIRECTIONS.items() for c in d}
+    assert listed == set(AGREE) | set(KNOWN)
