@@ -31,19 +31,25 @@ cuboid: $(OUT)/cuboid.json
 $(OUT)/cuboid.json: $(CONFIG) $(SRC) | setup
 	$(ARTIC) validate cuboid --config $(CONFIG) --out $@
 
+# the tissue model alone (section II): node-set loads, GG tendon and floor held
 $(SIMS)/%_novol.h5: $(SCHED)/%.yaml $(OUT)/mesh.h5
-	$(ARTIC) simulate --schedule $< --mesh $(OUT)/mesh.h5 --config $(CONFIG) --out $@ --no-volume-constraint
+	$(ARTIC) simulate --tongue-only --schedule $< --mesh $(OUT)/mesh.h5 --config $(CONFIG) --out $@ --no-volume-constraint
 
 $(SIMS)/%.h5: $(SCHED)/%.yaml $(OUT)/mesh.h5
-	$(ARTIC) simulate --schedule $< --mesh $(OUT)/mesh.h5 --config $(CONFIG) --out $@ --plot $(REPORT)/sim_$*.png
+	$(ARTIC) simulate --tongue-only --schedule $< --mesh $(OUT)/mesh.h5 --config $(CONFIG) --out $@ --plot $(REPORT)/sim_$*.png
 
-sims: $(SIMS)/gravity.h5 $(SIMS)/pull_2n.h5 $(SIMS)/pull_2n_novol.h5 $(SIMS)/stress_7n.h5
+# the whole articulator (section III): muscle schedules
+$(SIMS)/fig4_%.h5: $(SCHED)/fig4_%.yaml $(OUT)/mesh.h5
+	$(ARTIC) simulate --schedule $< --mesh $(OUT)/mesh.h5 --config $(CONFIG) --out $@ --plot $(REPORT)/fig4_$*.png
+
+sims: $(SIMS)/gravity.h5 $(SIMS)/pull_2n.h5 $(SIMS)/pull_2n_novol.h5 $(SIMS)/stress_7n.h5 \
+      $(SIMS)/fig4_ggp.h5 $(SIMS)/fig4_sg.h5
 
 figures: mesh sims
 
 paper: $(REPORT)/paper.md
 $(REPORT)/paper.md: $(OUT)/mesh.h5 $(OUT)/cuboid.json $(SIMS)/gravity.h5 $(SIMS)/pull_2n.h5 \
-                    $(SIMS)/pull_2n_novol.h5 $(SIMS)/stress_7n.h5
+                    $(SIMS)/pull_2n_novol.h5 $(SIMS)/stress_7n.h5 $(SIMS)/fig4_ggp.h5 $(SIMS)/fig4_sg.h5
 	$(ARTIC) report --data $(OUT) --out $@
 
 # --- checks ---------------------------------------------------------------
@@ -52,6 +58,7 @@ test: setup
 
 bench: setup
 	$(PY) benchmarks/bench_tissue.py
+	$(PY) benchmarks/bench_articulator.py
 
 clean:
 	rm -rf $(OUT)/*.h5 $(OUT)/*.json $(SIMS) $(REPORT)/*.png $(REPORT)/paper.md

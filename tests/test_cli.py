@@ -62,7 +62,8 @@ def schedule(tmp_path_factory):
 
 def test_simulate_writes_trajectories_volume_and_metadata(mesh_file, schedule, tmp_path):
     out = tmp_path / "sim.h5"
-    res = artic("simulate", "--schedule", schedule, "--mesh", mesh_file, "--out", out, "--plot", tmp_path / "s.png")
+    res = artic("simulate", "--tongue-only", "--schedule", schedule, "--mesh", mesh_file, "--out", out,
+                "--plot", tmp_path / "s.png")
     assert res.returncode == 0, res.stderr
     assert "max |volume change|" in res.stdout
     with h5py.File(out) as f:
@@ -79,13 +80,37 @@ def test_simulate_writes_trajectories_volume_and_metadata(mesh_file, schedule, t
 
 
 def test_simulate_without_constraint_reports_the_drift(mesh_file, schedule, tmp_path):
-    res = artic("simulate", "--schedule", schedule, "--mesh", mesh_file, "--out", tmp_path / "o.h5",
+    res = artic("simulate", "--tongue-only", "--schedule", schedule, "--mesh", mesh_file, "--out", tmp_path / "o.h5",
                 "--no-volume-constraint")
     assert res.returncode == 0, res.stderr
     assert "constraint off" in res.stdout
 
 
+def test_simulate_drives_muscles_of_the_whole_articulator(mesh_file, tmp_path):
+    sched = tmp_path / "sg.yaml"
+    sched.write_text("duration_ms: 30\nmuscles:\n  - {muscle: SG, force_n: 4, onset_ms: 0, duration_ms: 30}\n"
+                     "  - {muscle: JO, force_n: 3, onset_ms: 0, duration_ms: 30}\n")
+    out = tmp_path / "sg.h5"
+    res = artic("simulate", "--schedule", sched, "--mesh", mesh_file, "--out", out)
+    assert res.returncode == 0, res.stderr
+    with h5py.File(out) as f:
+        names = list(f["muscles"].attrs["names"])
+        force = f["muscles/force"][()][:, names.index("SG")]
+        length = f["muscles/length"][()][:, names.index("SG")]
+        assert force[0] == pytest.approx(4.0, rel=0.05)  # at rest length the force is the input
+        assert length[-1] < length[0] and force[-1] < force[0]  # shortening lowers it (Eq. 9)
+        tip = f["control_points/tip/position"][()]
+        jaw = f["control_points/jaw/position"][()]
+        assert tip[-1, 0] < tip[0, 0]  # SG draws the tip back
+        assert jaw[-1, 1] < jaw[0, 1]  # JO lowers the jaw
+        assert f["contacts/count"].shape == (7,)
+
+
 BAD_SCHEDULES = {
+    "unknown muscle": ("muscles:\n  - {muscle: GGz, force_n: 1, onset_ms: 0, duration_ms: 10}\n", "GGa, GGm"),
+    "negative force": ("muscles:\n  - {muscle: SG, force_n: -1, onset_ms: 0, duration_ms: 10}\n", "force_n"),
+    "overlap": ("muscles:\n  - {muscle: SG, force_n: 1, onset_ms: 0, duration_ms: 30}\n"
+                "  - {muscle: SG, force_n: 2, onset_ms: 10, duration_ms: 30}\n", "overlap"),
     "nan force": ("loads:\n  - {nodes: tip, force_n: [.nan, 0, 0], onset_ms: 0, duration_ms: 10}\n", "force_n"),
     "unknown node set": ("loads:\n  - {nodes: nose, force_n: [1, 0, 0], onset_ms: 0, duration_ms: 10}\n", "nose"),
     "unknown key": ("loads:\n  - {nodes: tip, force: [1, 0, 0], onset_ms: 0, duration_ms: 10}\n", "force"),

@@ -90,7 +90,7 @@ def run(model: Model, state: State, control_at: Callable[[float], Control], dura
     gravity = model.node_mass[:, None] * model.gravity
     t0 = time.perf_counter()
     for k in range(1, n_steps + 1):
-        ctl = control_at(state.t + h)
+        ctl = control_at(state.t + 0.5 * h)  # inputs held over the step, sampled at its middle
         new = step(model, state, ctl, h)
         # work of the external forces (held over the step) and gravity
         w += float(np.einsum("ij,ij->", ctl.force + gravity, new.x - state.x))

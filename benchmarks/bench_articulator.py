@@ -1,0 +1,62 @@
+"""Speed of the whole articulator (tongue, jaw, hyoid, muscles, contact, volume constraint).
+
+Goal (issue "muscles, jaw-hyoid complex and contact"): at most 0.5 s of wall
+time per simulated second on one core.  Prints the ratio and the share of
+time spent in contact handling.
+"""
+
+from __future__ import annotations
+
+import os
+
+for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ[var] = "1"
+
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+from artic_cli.config import load_config  # noqa: E402
+from artic_cli.geometry.mesh import tongue_mesh  # noqa: E402
+from artic_cli.geometry.wall import wall_surface  # noqa: E402
+from artic_cli.mechanics import integrator  # noqa: E402
+from artic_cli.mechanics.loads import activation_vector  # noqa: E402
+from artic_cli.mechanics.model import Control, build_articulator  # noqa: E402
+from artic_cli.mechanics.simulate import run, settle  # noqa: E402
+
+ROOT = Path(__file__).resolve().parent.parent
+GOAL = 0.5
+
+
+def main() -> None:
+    cfg = load_config(ROOT / "configs" / "default.yaml")
+    model = build_articulator(cfg, tongue_mesh(cfg.speaker.tongue), wall_surface(cfg.speaker.wall))
+    rest = settle(model)
+    import numpy as np
+
+    ctl = Control(force=np.zeros((model.n_nodes, 3)), activation=activation_vector(model, {"SG": 4.0, "JO": 3.0}))
+    spent = {"contact": 0.0}
+    for name in ("contact_planes", "contact_forces", "enforce"):
+        fn = getattr(integrator, name)
+
+        def timed(*a, _fn=fn, **k):
+            t0 = time.perf_counter()
+            try:
+                return _fn(*a, **k)
+            finally:
+                spent["contact"] += time.perf_counter() - t0
+
+        setattr(integrator, name, timed)
+    traj, end = run(model, rest, lambda t: ctl, 0.3)
+    wall = traj.stats["wall_time_s"]
+    ratio = wall / 0.3
+    print(f"articulator: {model.n_nodes} nodes ({model.n_tongue} tongue), {len(model.muscle_names)} muscles, "
+          f"{len(model.cyl.i)} cylinders and links, dt = {model.options.dt * 1e3:g} ms")
+    print(f"300 ms of SG 4 N + JO 3 N: {wall * 1e3:.0f} ms wall, {ratio:.2f} s per simulated second "
+          f"(goal <= {GOAL}) -> {'MET' if ratio <= GOAL else 'NOT MET'}")
+    print(f"Newton iterations {traj.stats['newton_iterations']} "
+          f"({traj.stats['newton_iterations'] / traj.stats['steps']:.1f}/step), "
+          f"factorisations {traj.stats['refactors']}; contact handling {100 * spent['contact'] / wall:.0f} % of the time")
+
+
+if __name__ == "__main__":
+    main()
