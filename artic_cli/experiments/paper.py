@@ -11,7 +11,6 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from .. import units
 from ..mechanics.loads import activation_vector
 from ..mechanics.model import Control, Model
 from ..mechanics.simulate import run, settle
@@ -141,4 +140,4 @@ def rows_as_dicts(rows: list[Row]) -> list[dict]:
     return [asdict(r) for r in rows]
 
 
-__all__ = ["EXPERIMENTS", "Row", "rows_as_dicts", "units"]
+__all__ = ["EXPERIMENTS", "Row", "rows_as_dicts"]
