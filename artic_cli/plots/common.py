@@ -46,8 +46,10 @@ def wall_outlines(wall: WallSurface, z: float = 0.0):
     return out
 
 
-def draw_wall(ax, wall: WallSurface, lateral: bool = True) -> None:
+def draw_wall(ax, wall: WallSurface, lateral: bool = True, parts=None) -> None:
     for name, xy in wall_outlines(wall, 0.0).items():
+        if parts is not None and name not in parts:
+            continue
         ax.plot(xy[:, 0], xy[:, 1], color=WALL_STYLE[name], lw=2.0, label=f"{name} (midsagittal)")
     if lateral:
         zs = np.unique(np.round(wall.vertices[:, 2], 6))
