@@ -54,7 +54,7 @@ $(REPORT)/paper.md: $(OUT)/mesh.h5 $(OUT)/cuboid.json $(SIMS)/gravity.h5 $(SIMS)
 
 # --- checks ---------------------------------------------------------------
 test: setup
-	$(PY) -m pytest -q
+	$(PY) -m pytest
 
 bench: setup
 	$(PY) benchmarks/bench_tissue.py
