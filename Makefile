@@ -1,5 +1,5 @@
-# artic: reproducible runs.  `make setup paper` builds every stage and the report;
-# `make setup test` runs the tests.  Stages rerun only when their inputs changed.
+# artic: reproducible runs.  `make setup && make paper` builds every stage and the report;
+# `make setup && make test` runs the tests.  Stages rerun only when their inputs changed.
 PYTHON ?= python3
 VENV   ?= .venv
 CONFIG ?= configs/default.yaml
