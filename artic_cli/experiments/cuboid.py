@@ -24,7 +24,7 @@ import numpy as np
 
 from .. import units
 from ..config import Config
-from ..geometry.mesh import cuboid_mesh
+from ..geometry.mesh import cuboid_mesh, face_weights
 from ..mechanics.model import Control, build_model, rest_state
 from ..mechanics.simulate import equilibrate
 from ..mechanics.model import tongue_volume
@@ -43,19 +43,6 @@ class CuboidRow:
     converged: bool
 
 
-def _tributary(c: np.ndarray) -> np.ndarray:
-    """Length each grid coordinate stands for along one axis (half cells at the ends)."""
-    g = np.unique(c)
-    half = np.diff(g) / 2.0
-    share = np.concatenate([[0.0], half]) + np.concatenate([half, [0.0]])
-    return share[np.searchsorted(g, c)]
-
-
-def end_weights(nodes: np.ndarray, face: np.ndarray, size) -> np.ndarray:
-    """Nodal shares of a uniform traction on the face x = L (they sum to 1)."""
-    return _tributary(nodes[face, 1]) * _tributary(nodes[face, 2]) / (size[1] * size[2])
-
-
 def run_cuboid(cfg: Config, forces_n=None, volume_constraint: bool | None = None) -> list[CuboidRow]:
     size = cfg.cuboid.size_cm
     mesh = cuboid_mesh(size, cfg.cuboid.bricks)
@@ -70,7 +57,7 @@ def run_cuboid(cfg: Config, forces_n=None, volume_constraint: bool | None = None
     model = build_model(mesh, cfg.materials.tongue, cfg.simulation, fixed_dofs=fixed, gravity=0.0,
                         volume_constraint=volume_constraint)
     face = mesh.node_sets["pulled_end"]
-    weights = end_weights(x0, face, size)
+    weights = face_weights(x0, face)
     xs = np.unique(np.round(x0[:, 0], 9))
     mid = xs[np.argsort(np.abs(xs - 0.5 * size[0]))[:2]]  # the two planes nearest mid-length
     gauge = np.isin(np.round(x0[:, 0], 9), mid)

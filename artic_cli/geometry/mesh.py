@@ -159,6 +159,20 @@ def tongue_mesh(geo: TongueGeometry) -> Mesh:
     return assemble_mesh(nodes, bricks, sets, "tongue", (nr + 1, nc + 1, PLANES))
 
 
+def _tributary(c: np.ndarray) -> np.ndarray:
+    """Length each grid coordinate stands for along one axis (half cells at the ends)."""
+    g = np.unique(c)
+    half = np.diff(g) / 2.0
+    share = np.concatenate([[0.0], half]) + np.concatenate([half, [0.0]])
+    return share[np.searchsorted(g, c)]
+
+
+def face_weights(nodes: np.ndarray, face: np.ndarray) -> np.ndarray:
+    """Nodal shares (summing to 1) of a uniform traction on a box face normal to x."""
+    w = _tributary(nodes[face, 1]) * _tributary(nodes[face, 2])
+    return w / w.sum()
+
+
 def cuboid_mesh(size_cm, bricks_per_axis) -> Mesh:
     """The paper's test body: a box of ``size_cm`` split into bricks (node numbering x slowest)."""
     nx, ny, nz = bricks_per_axis

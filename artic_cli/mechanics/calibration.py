@@ -22,7 +22,7 @@ import scipy.sparse.linalg as spla
 from scipy.optimize import brentq
 
 from ..geometry.hexahedra import volume_gradients
-from ..geometry.mesh import cuboid_mesh
+from ..geometry.mesh import cuboid_mesh, face_weights
 from .assembly import pair_blocks, sparse_blocks
 from .isotropy import isotropic_areas
 
@@ -50,10 +50,8 @@ def lattice_response(bulk_ratio: float, isotropic: bool = True, cells: int = _CE
     free = np.flatnonzero(~fixed.ravel())
     f = np.zeros((len(x), 3))
     far = np.isclose(x[:, 0], cells)
-    # tributary areas of a uniform unit traction on the far face
-    wy = np.where(np.isclose(x[:, 1], 0) | np.isclose(x[:, 1], cells), 0.5, 1.0)
-    wz = np.where(np.isclose(x[:, 2], 0) | np.isclose(x[:, 2], cells), 0.5, 1.0)
-    f[far, 0] = (wy * wz)[far]
+    face = np.flatnonzero(far)
+    f[face, 0] = cells * cells * face_weights(x, face)  # a uniform unit traction on the far face
     u = np.zeros(3 * len(x))
     u[free] = spla.spsolve(kmat[free][:, free].tocsc(), f.ravel()[free])
     u = u.reshape(-1, 3)
