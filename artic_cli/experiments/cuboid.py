@@ -65,10 +65,14 @@ def run_cuboid(cfg: Config, forces_n=None, volume_constraint: bool | None = None
     area = size[1] * size[2]
     state = rest_state(model)
     rows = []
+    done, ok = 0.0, True
     for fn in sorted(cfg.cuboid.forces_n if forces_n is None else forces_n):
-        f = np.zeros_like(x0)
-        f[face, 0] = units.newton_to_dyn(fn) * weights
-        state, ok = equilibrate(model, state, Control(force=f), dt=0.02, tol=1e-3, max_time=10.0)
+        # load in increments of at most 0.5 N from the last equilibrium (large jumps neck the block)
+        for level in np.linspace(done, fn, int(np.ceil((fn - done) / 0.5)) + 1)[1:]:
+            f = np.zeros_like(x0)
+            f[face, 0] = units.newton_to_dyn(level) * weights
+            state, ok = equilibrate(model, state, Control(force=f), dt=0.02, tol=1e-3, max_time=10.0)
+        done = fn
         x = state.x
         axial = x[face, 0].mean() / size[0] - 1.0
         lat = []
