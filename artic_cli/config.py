@@ -120,12 +120,16 @@ class Muscles(_Strict):
         "JO": {"lateral_pterygoid_upper": 0.25, "lateral_pterygoid_lower": 0.25, "anterior_digastric": 0.5},
         "JC": {"temporalis_anterior": 0.3, "temporalis_posterior": 0.2, "masseter": 0.3, "medial_pterygoid": 0.2},
         "T-SL": {"T": 1.0, "SL": 1.0}}
+    # Steady force (N) of muscles or groups in every state, on top of the control: the jaw closers'
+    # postural tone holds the mandible at its reference height against gravity.
+    postural_tone_n: dict[str, NonNeg] = {"JC": 2.1}
 
 
 class Jaw(_Strict):
     link_area_cm2: Positive = 0.1
     eminence_slope_deg: Annotated[float, Field(ge=-80, le=0)] = -30.0
     guide_stiffness_n_per_cm: Positive = 1000.0
+    fossa_stop: bool = True           # the condyle cannot slide back beyond its rest seat in the glenoid fossa
     passive_stiffness_n_per_cm: NonNeg = 0.5
     strap_stiffness_n_per_cm: NonNeg = 10.0
     floor_link_area_cm2: Positive = 0.3

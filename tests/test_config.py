@@ -13,7 +13,10 @@ def _data(cfg):
 
 def test_default_config_loads_with_table_i_values(cfg):
     t = cfg.materials.tongue
-    assert (t.density_g_cm3, t.youngs_modulus_kpa, t.viscosity_kpa_s, t.poisson_ratio) == (1.0, 20.0, 2.0, 0.49)
+    assert (t.density_g_cm3, t.youngs_modulus_kpa, t.poisson_ratio) == (1.0, 20.0, 0.49)
+    # Table I's 2.0 kPa s was fitted by the paper to its truss's speeds; the same fit on our calibrated
+    # continuum (Table II speeds of the fig4 experiment) gives a tenth of it (README, "viscosity")
+    assert t.viscosity_kpa_s == 0.2
     assert cfg.materials.bone.mandible_mass_g == 150.0 and cfg.materials.bone.hyoid_mass_g == 5.0
     assert cfg.simulation.gravity_cm_s2 == 980.0
 

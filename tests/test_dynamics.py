@@ -41,7 +41,9 @@ def test_shortcuts_cost_little_accuracy(model):
     fast = _run(model, PULL_2N, 0.3)
     exact_model = with_options(model, tol=1e-9, refactor_rate=1e-12, max_iter=60)
     exact = _run(exact_model, PULL_2N, 0.3)
-    assert fast.stats["refactors"] < fast.stats["steps"] / 4  # the factor really is reused
+    # the factor really is reused: most steps and iterations run on an old factorisation
+    assert fast.stats["refactors"] < fast.stats["steps"] / 2
+    assert fast.stats["refactors"] < exact.stats["refactors"] / 5
     assert np.linalg.norm(fast.x - exact.x, axis=2).max() < 1e-3
 
 

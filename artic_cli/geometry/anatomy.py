@@ -161,7 +161,7 @@ def build_body(cfg: Config, mesh: Mesh | None = None) -> Body:
     fib: dict[str, list[np.ndarray]] = {m: [] for m in TONGUE_MUSCLES + JAW_MUSCLES}
     radial = lambda k, p, j0=0, j1=nc - 1: chain([t(k, j, p) for j in range(j0, j1 + 1)])  # noqa: E731
     last = nr - 1
-    for k in range(1, 4):
+    for k in range(0, 4):  # the front radial lines, the first one under the tip
         fib["GGa"].append(radial(k, mid))
     for k in range(4, 7):
         fib["GGm"].append(radial(k, mid))
@@ -173,7 +173,8 @@ def build_body(cfg: Config, mesh: Mesh | None = None) -> Body:
                 fib["HG"].append(chain([h] + [t(k, j, p) for k in range(last, 6, -1)]))
         fib["SG"].append(chain([styloid[s], t(8, 4, p)] + [t(k, 3, p) for k in range(7, 0, -1)]))
         fib["SG"].append(chain([styloid[s], t(7, 5, p)] + [t(k, 5, p) for k in range(6, 2, -1)]))
-        fib["IL"].append(chain([t(k, 2, p) for k in range(last - 1, 0, -1)] + [t(0, j, p) for j in range(3, nc)]))
+        # lower side, root to tip, parasagittal planes only (between GG and HG)
+        fib["IL"].append(chain([t(k, 2, p) for k in range(last, 0, -1)] + [t(0, j, p) for j in range(3, nc)]))
         fib["MH"].append(chain([myl_front[s], t(last, 1, mid)]))
         fib["MH"].append(chain([myl_mid[s], t(last, 3, mid)]))
         fib["MH"].append(chain([myl_back[s], t(last, 5, mid)]))
@@ -190,12 +191,12 @@ def build_body(cfg: Config, mesh: Mesh | None = None) -> Body:
     for p in range(planes):
         fib["SL"].append(chain([t(k, nc - 2, p) for k in range(8, 0, -1)] + [t(0, nc - 1, p)]))
         if p != mid:
-            for k in range(1, 5):
+            for k in range(0, 4):
                 fib["V"].append(chain([t(k, j, p) for j in range(nc - 1, 2, -1)]))
     for k in range(2, 8):
         for j in (nc - 3, nc - 2):
             fib["T"].append(chain([t(k, j, 0), t(k, j, mid), t(k, j, planes - 1)]))
-    for k in range(1, 5):
+    for k in range(0, 4):  # front part of the tongue, dorsum down into the blade
         fib["V"].append(chain([t(k, j, mid) for j in range(nc - 1, 2, -1)]))
 
     nodes = np.array(b.points)

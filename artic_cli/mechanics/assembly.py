@@ -147,11 +147,43 @@ class BandFactor:
         return np.concatenate([z1 - self.y @ x2, x2])
 
 
+@dataclass(frozen=True)
+class LowRankFactor:
+    """Solves with A + G diag(k) G^T by the Woodbury identity, from a factor of A."""
+
+    base: BandFactor
+    terms_key: tuple  # what the rank-one terms were built for
+    g: np.ndarray | None = None  # (n_free, r)
+    z: np.ndarray | None = None  # A^-1 G
+    s: tuple | None = None  # Cholesky of diag(1/k) + G^T A^-1 G
+
+    @property
+    def key(self) -> tuple:
+        return self.base.key
+
+    def solve(self, rhs: np.ndarray) -> np.ndarray:
+        y = self.base.solve(rhs)
+        if self.g is None:
+            return y
+        return y - self.z @ cho_solve(self.s, self.g.T @ y, check_finite=False)
+
+
+def add_low_rank(base: BandFactor, g: np.ndarray, k: np.ndarray, terms_key: tuple = ()) -> LowRankFactor:
+    """Factor of A + G diag(k) G^T (k > 0) for rank-one terms that do not fit the band."""
+    if g.shape[1] == 0:
+        return LowRankFactor(base=base, terms_key=terms_key)
+    z = base.solve(g)
+    return LowRankFactor(base=base, terms_key=terms_key, g=g, z=z,
+                         s=cho_factor(np.diag(1.0 / k) + g.T @ z, check_finite=False))
+
+
 def factorize(mat: SystemMatrix, key: tuple) -> BandFactor:
     cb = cholesky_banded(mat.band, lower=False, check_finite=False)
     if mat.c.size == 0:
         return BandFactor(cb=cb, key=key)
-    y = cho_solve_banded((cb, False), mat.b, check_finite=False)
+    y = np.zeros_like(mat.b)
+    coupled = np.flatnonzero(np.any(mat.b != 0.0, axis=0))  # border dofs with no link to the core need no solve
+    y[:, coupled] = cho_solve_banded((cb, False), mat.b[:, coupled], check_finite=False)
     schur = cho_factor(mat.c - mat.b.T @ y, check_finite=False)
     return BandFactor(cb=cb, key=key, y=y, b=mat.b, schur=schur)
 

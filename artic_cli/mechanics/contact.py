@@ -151,23 +151,28 @@ def wall_query(cm: ContactModel, x: np.ndarray, nodes: np.ndarray | None = None)
     return q, n, g, use_jaw
 
 
-def contact_planes(cm: ContactModel, x: np.ndarray) -> ContactPlanes:
-    q, n, g, jaw = wall_query(cm, x)
+def contact_planes(cm: ContactModel, x: np.ndarray, query=None) -> ContactPlanes:
+    """The step's planes for the nodes within ``margin`` of the wall (``query``: a wall_query at x)."""
+    q, n, g, jaw = wall_query(cm, x) if query is None else query
     near = g > -cm.margin
     return ContactPlanes(nodes=cm.nodes[near], q=q[near], n=n[near], jaw=jaw[near], jaw_nodes=cm.jaw_nodes,
                          jaw_ref=x[cm.jaw_nodes].mean(axis=0))
 
 
-def enforce(cm: ContactModel, x: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
-    """Project nodes beyond the wall by more than the tolerance back onto it."""
-    q, n, g, _ = wall_query(cm, x)
+def enforce(cm: ContactModel, x: np.ndarray, v: np.ndarray):
+    """Project nodes beyond the wall by more than the tolerance back onto it.
+
+    Returns x, v, the number of projected nodes and the wall query at the returned x when no node
+    moved (the next step's planes come from it), else None."""
+    query = wall_query(cm, x)
+    q, n, g, _ = query
     bad = g > cm.tolerance
     if not bad.any():
-        return x, v, 0
+        return x, v, 0, query
     x = x.copy()
     v = v.copy()
     idx = cm.nodes[bad]
     x[idx] = x[idx] - (g[bad] - 0.5 * cm.tolerance)[:, None] * n[bad]
     vn = (v[idx] * n[bad]).sum(axis=1)
     v[idx] -= np.maximum(vn, 0.0)[:, None] * n[bad]
-    return x, v, int(bad.sum())
+    return x, v, int(bad.sum()), None

@@ -23,14 +23,17 @@ import numpy as np
 
 from ..errors import ArticError
 from . import elements
-from .assembly import factorize, pair_blocks
+from .assembly import add_low_rank, factorize, pair_blocks
 from .contact import ContactPlanes, contact_planes, enforce
 from .model import Control, Model, State
-from .muscles import FibreState, fibre_state, muscle_forces
+from .muscles import FibreState, fibre_state, fibre_stiffness, length_gradients, muscle_forces
 from .volume import volume_forces
 
 _EYE = np.eye(3)
 _MAX_INCREMENT = 0.2  # cm: the largest node move one Newton iteration may make
+# Fibres stiffer than this along their length (dyn/cm; active muscles on the steep side of Eq. 9) enter the
+# tangent exactly, as rank-one terms k g g^T solved by Woodbury; softer ones are split over their segments.
+_RANK_ONE_STIFFNESS = 2.0e4
 
 
 class SimulationDiverged(ArticError):
@@ -56,7 +59,26 @@ def guide_forces(model: Model, x: np.ndarray) -> np.ndarray:
         d = x[gd.nodes] - gd.origin
         off = np.einsum("gi,gmi->gm", d, gd.normals)
         f[gd.nodes] = -gd.stiffness * np.einsum("gm,gmi->gi", off, gd.normals)
+        behind = guide_stop(gd, x)
+        if behind.any():
+            s = np.einsum("gi,gi->g", d, gd.path)
+            f[gd.nodes] -= gd.stiffness * np.where(behind, s, 0.0)[:, None] * gd.path
     return f
+
+
+def total_activation(model: Model, activation: np.ndarray | None) -> np.ndarray | None:
+    """The control's muscle forces plus the model's postural tone (dyn), or None without muscles."""
+    if model.muscles is None:
+        return None
+    act = np.zeros(len(model.muscles.names)) if activation is None else activation
+    return act + model.tone if model.tone is not None else act
+
+
+def guide_stop(gd, x: np.ndarray) -> np.ndarray:
+    """(G,) which guided nodes press on the back stop of their line."""
+    if gd is None or gd.path is None:
+        return np.zeros(0 if gd is None else len(gd.nodes), dtype=bool)
+    return np.einsum("gi,gi->g", x[gd.nodes] - gd.origin, gd.path) < 0.0
 
 
 def contact_forces(model: Model, x: np.ndarray, planes: ContactPlanes | None):
@@ -76,8 +98,12 @@ def contact_forces(model: Model, x: np.ndarray, planes: ContactPlanes | None):
 
 
 def tangent(model: Model, cs: elements.CylinderState, frame: elements.DampingFrame, grad,
-            fs: FibreState | None, planes: ContactPlanes | None, active: np.ndarray, c_a: float, c_v: float):
-    k_geo = np.maximum(cs.elastic, 0.0) / cs.length
+            fs: FibreState | None, act: np.ndarray | None, h: float, c_a: float, c_v: float,
+            signed_geometry: bool = True):
+    """The banded part of the Newton matrix: mass, cylinders and links, volume, fibres' own blocks, guide."""
+    # geometric stiffness T / l with its sign: compressed cylinders soften sideways (the mass term keeps
+    # the matrix positive definite at these loads; a failed factorisation falls back to clipping)
+    k_geo = (cs.elastic if signed_geometry else np.maximum(cs.elastic, 0.0)) / cs.length
     k_nn = np.maximum(elements.axial_stiffness(model.cyl, cs), 0.0) - k_geo
     k3 = (k_nn[:, None, None] * (cs.n[:, :, None] * cs.n[:, None, :]) + k_geo[:, None, None] * _EYE
           + (c_v * frame.c)[:, None, None] * (frame.n[:, :, None] * frame.n[:, None, :]))
@@ -90,33 +116,56 @@ def tangent(model: Model, cs: elements.CylinderState, frame: elements.DampingFra
         val.append(w[:, None, None] * g[:, :, None] * g[:, None, :])
     if fs is not None:
         t = np.maximum(fs.tension[model.muscles.seg_fibre], 0.0) / fs.seg_length
-        kk = t[:, None, None] * (_EYE - fs.n[:, :, None] * fs.n[:, None, :])
+        nn = fs.n[:, :, None] * fs.n[:, None, :]
+        kf = fibre_stiffness(model.muscles, fs, act, h)
+        soft = np.where(kf < _RANK_ONE_STIFFNESS, kf * model.muscles.fibre_l0, 0.0)  # split in series
+        kk = t[:, None, None] * (_EYE - nn) + (soft[model.muscles.seg_fibre] / model.muscles.seg_l0)[:, None, None] * nn
         idx.append(model.seg_index)
         val.append(pair_blocks(kk))
     if model.guide is not None:
         gd = model.guide
         idx.append(gd.index)
         val.append(gd.stiffness * np.einsum("gmi,gmj->gij", gd.normals, gd.normals))
-    if planes is not None and active.any():
-        k = model.contact.stiffness
-        wall_side = active & ~planes.jaw
-        if wall_side.any():
-            pos = np.searchsorted(model.contact.nodes, planes.nodes[wall_side])
-            n = planes.n[wall_side]
-            idx.append(model.contact_index[pos])
-            val.append(k * n[:, :, None] * n[:, None, :])
-        jaw_side = active & planes.jaw
-        if jaw_side.any():
-            jn = planes.jaw_nodes
-            nodes = np.column_stack([planes.nodes[jaw_side], np.broadcast_to(jn, (jaw_side.sum(), len(jn)))])
-            n = planes.n[jaw_side]
-            vec = np.concatenate([n[:, None, :], np.repeat(-n[:, None, :] / len(jn), len(jn), axis=1)], axis=1)
-            vec = vec.reshape(len(n), -1)
-            idx.append(model.pattern.block_index(nodes))
-            val.append(k * vec[:, :, None] * vec[:, None, :])
     flat_i = np.concatenate([i.ravel() for i in idx])
     flat_v = np.concatenate([v.ravel() for v in val])
     return c_a * model.mass_matrix + model.pattern.assemble(flat_i, flat_v)
+
+
+def rank_one_terms(model: Model, x: np.ndarray, fs: FibreState | None, act: np.ndarray | None, h: float,
+                   planes: ContactPlanes | None, active: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Newton terms k v v^T that change often or do not fit the band: (V (3N, r), k (r,)).
+
+    Stiff fibres (along their whole length), active wall contacts (with the reaction on the mandible)
+    and condyles on the fossa stop.  They update the banded factor by Woodbury, so a change of the
+    contact set does not refactor the band.
+    """
+    n3 = 3 * model.n_nodes
+    cols, ks = [], []
+    if fs is not None:
+        kf = fibre_stiffness(model.muscles, fs, act, h)
+        stiff = np.flatnonzero(kf >= _RANK_ONE_STIFFNESS)
+        if len(stiff):
+            cols.append(length_gradients(model.muscles, fs, stiff, model.n_nodes))
+            ks.append(kf[stiff])
+    if planes is not None and active.any():
+        nodes, n = planes.nodes[active], planes.n[active]
+        v = np.zeros((model.n_nodes, 3, len(nodes)))
+        v[nodes, :, np.arange(len(nodes))] = n
+        on_jaw = planes.jaw[active]
+        for c in np.flatnonzero(on_jaw):
+            v[planes.jaw_nodes, :, c] -= n[c] / len(planes.jaw_nodes)
+        cols.append(v.reshape(n3, -1))
+        ks.append(np.full(len(nodes), model.contact.stiffness))
+    stop = guide_stop(model.guide, x)
+    if stop.any():
+        gd = model.guide
+        v = np.zeros((model.n_nodes, 3, int(stop.sum())))
+        v[gd.nodes[stop], :, np.arange(int(stop.sum()))] = gd.path[stop]
+        cols.append(v.reshape(n3, -1))
+        ks.append(np.full(int(stop.sum()), gd.stiffness))
+    if not cols:
+        return np.zeros((n3, 0)), np.zeros(0)
+    return np.hstack(cols), np.concatenate(ks)
 
 
 def _coefficients(model: Model, state: State, h: float):
@@ -140,8 +189,35 @@ def _predict(state: State, h: float) -> np.ndarray:
     return state.x + h * state.v
 
 
+_MAX_HALVINGS = 4  # a step whose Newton stalls is retried as two half steps, down to dt / 16
+
+
+class _Stalled(Exception):
+    pass
+
+
 def step(model: Model, state: State, control: Control, dt: float | None = None) -> State:
+    """Advance ``state`` by ``dt`` (default: the model's step) under ``control``.
+
+    If Newton stalls (a soft mode near a force-length or volume-constraint limit can make modified
+    Newton creep), the step is taken as two half steps, recursively, before giving up.
+    """
     h = float(model.options.dt if dt is None else dt)
+    return _step_split(model, state, control, h, _MAX_HALVINGS)
+
+
+def _step_split(model: Model, state: State, control: Control, h: float, depth: int) -> State:
+    try:
+        return _step_once(model, state, control, h)
+    except _Stalled:
+        if depth == 0:
+            raise SimulationDiverged(f"Newton did not converge at t = {state.t * 1e3:.1f} ms even with steps of "
+                                     f"{h * 1e3:.3g} ms; lower the loads or --dt") from None
+    mid = _step_split(model, state, control, 0.5 * h, depth - 1)
+    return _step_split(model, mid, control, 0.5 * h, depth - 1)
+
+
+def _step_once(model: Model, state: State, control: Control, h: float) -> State:
     opt = model.options
     c_a, a_known, c_v, v_known, history = _coefficients(model, state, h)
     f_ext = control.force + model.node_mass[:, None] * model.gravity
@@ -150,12 +226,15 @@ def step(model: Model, state: State, control: Control, dt: float | None = None) 
     x[model.fixed] = state.x[model.fixed]
     refactors = state.refactors
     frame = elements.damping_frame(model.cyl, state.x)
-    planes = contact_planes(model.contact, state.x) if model.contact is not None else None
+    planes = None
+    if model.contact is not None:
+        cached = state.wall_cache is not None and state.wall_cache[0] is state.x
+        planes = contact_planes(model.contact, state.x, state.wall_cache[1] if cached else None)
     ms = model.muscles
-    act = control.activation if control.activation is not None else (np.zeros(len(ms.names)) if ms else None)
+    act = total_activation(model, control.activation)
     key = (c_a, c_v)
-    factor = state.factor if state.factor is not None and state.factor.key[:2] == key else None
-    active_prev = state.factor.key[2] if state.factor is not None and len(state.factor.key) > 2 else None
+    base = state.factor.base if state.factor is not None and state.factor.key == key else None
+    factor = None
     prev = None
     fresh = False
     fs = None
@@ -169,48 +248,57 @@ def step(model: Model, state: State, control: Control, dt: float | None = None) 
             f += muscle_forces(ms, fs)
         fc, active, _ = contact_forces(model, x, planes)
         f += fc
-        active_key = None if planes is None else (tuple(planes.nodes[active]))
-        if factor is not None and planes is not None and active_key != active_prev:
-            factor = None
+        active_key = (None if planes is None else tuple(planes.nodes[active]), tuple(guide_stop(model.guide, x)))
+        if factor is not None and active_key != factor.terms_key:
+            factor = None  # contact set changed: keep the band, redo the small Woodbury part
         resid = (model.mass @ a - f - f_ext).ravel()[free]
         if factor is None:
             try:
-                factor = factorize(tangent(model, cs, frame, grad, fs, planes, active, c_a, c_v), (*key, active_key))
+                if base is None:
+                    try:
+                        base = factorize(tangent(model, cs, frame, grad, fs, act, h, c_a, c_v), key)
+                    except np.linalg.LinAlgError:
+                        base = factorize(tangent(model, cs, frame, grad, fs, act, h, c_a, c_v, False), key)
+                    refactors += 1
+                vecs, ks = rank_one_terms(model, x, fs, act, h, planes, active)
+                factor = add_low_rank(base, vecs[free], ks, active_key)
             except np.linalg.LinAlgError:
                 raise SimulationDiverged(f"the tissue lost stability at t = {state.t * 1e3:.1f} ms (tangent not "
                                          "positive definite); lower the loads or --dt") from None
-            refactors += 1
             fresh = True
-            active_prev = active_key
         dx = factor.solve(resid)
         size = float(np.abs(dx).max()) if dx.size else 0.0
         if not np.isfinite(size):
             raise SimulationDiverged(f"simulation diverged at t = {state.t * 1e3:.1f} ms; try a smaller --dt")
         if size > _MAX_INCREMENT:  # damp wild iterates (stale factor, sudden loads)
             dx *= _MAX_INCREMENT / size
-            factor = None if not fresh else factor
+            if not fresh:
+                factor = base = None
         x.reshape(-1)[free] -= dx
         if size < opt.tol:
             break
         if prev is not None and size > opt.refactor_rate * prev and not fresh:
-            factor = None
+            factor = base = None
         fresh = False
         prev = size
     else:
-        raise SimulationDiverged(
-            f"Newton did not converge at t = {state.t * 1e3:.1f} ms in {opt.max_iter} iterations; try a smaller --dt")
+        raise _Stalled()
     v_new = c_v * x + v_known
     projected = 0
+    wall_cache = None
     contact_nodes = np.zeros(0, dtype=np.int64)
     contact_force = np.zeros(0)
     if model.contact is not None:
         _, active, mag = contact_forces(model, x, planes)
         contact_nodes, contact_force = planes.nodes[active], mag[active]
-        x, v_new, projected = enforce(model.contact, x, v_new)
+        x, v_new, projected, query = enforce(model.contact, x, v_new)
+        if query is not None:
+            wall_cache = (x, query)
     sigma2, strain = state.sigma2, state.fibre_strain
     if ms is not None:
         fs = fibre_state(ms, x, act, state.sigma2, state.fibre_strain, h)
         sigma2, strain = fs.sigma2, fs.strain
     return replace(state, t=state.t + h, x=x, v=v_new, history=history, history_dt=h, factor=factor,
                    iterations=it, refactors=refactors, sigma2=sigma2, fibre_strain=strain,
-                   contact_nodes=contact_nodes, contact_force=contact_force, projected=projected)
+                   contact_nodes=contact_nodes, contact_force=contact_force, projected=projected,
+                   wall_cache=wall_cache)

@@ -46,13 +46,19 @@ class SolverOptions:
 
 @dataclass(frozen=True)
 class Guide:
-    """Nodes held on lines: force -k sum_m ((x - x0) . m) m over the normals m."""
+    """Nodes held on lines: force -k sum_m ((x - x0) . m) m over the normals m.
+
+    With ``path`` (the line's forward direction) the line ends at ``x0``: a
+    node behind it (s = (x - x0) . path < 0, the condyle pressed into the back
+    of the glenoid fossa) is pushed forward with -k s path.
+    """
 
     nodes: np.ndarray  # (G,)
     origin: np.ndarray  # (G,3)
     normals: np.ndarray  # (G,2,3)
     stiffness: float  # dyn/cm
     index: np.ndarray  # (G,3,3) storage indices
+    path: np.ndarray | None = None  # (G,3) forward unit vectors: a one-sided stop at the origin
 
 
 @dataclass(frozen=True)
@@ -82,6 +88,7 @@ class Model:
     contact: ContactModel | None = None
     contact_index: np.ndarray | None = None  # (P,3,3) for contact nodes
     wall: WallSurface | None = None
+    tone: np.ndarray | None = None  # (M,) postural muscle forces, dyn, added to every control's
 
     @property
     def n_nodes(self) -> int:
@@ -126,6 +133,7 @@ class State:
     contact_nodes: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     contact_force: np.ndarray = field(default_factory=lambda: np.zeros(0))  # dyn, per contact node
     projected: int = 0  # nodes put back on the wall after the last step
+    wall_cache: tuple | None = None  # scratch: (x, wall query at x) for the next step's contact planes
 
 
 @dataclass(frozen=True)
@@ -201,9 +209,9 @@ def _finish(mesh: Mesh, rest: np.ndarray, cyl: CylinderSet, link_mass: np.ndarra
         extra["seg_index"] = pattern.block_index(np.column_stack([ms.seg_i, ms.seg_j]))
     guide = extra.pop("guide_spec", None)
     if guide is not None:
-        nodes, origin, normals, k = guide
+        nodes, origin, normals, k, path = guide
         extra["guide"] = Guide(nodes=nodes, origin=origin, normals=normals, stiffness=k,
-                               index=pattern.diagonal_index(nodes))
+                               index=pattern.diagonal_index(nodes), path=path)
     if extra.get("contact") is not None:
         extra["contact_index"] = pattern.diagonal_index(extra["contact"].nodes)
     return Model(mesh=mesh, rest=rest, cyl=cyl, bricks=mesh.bricks, brick_v0=volumes(mesh.nodes, mesh.bricks),
@@ -320,7 +328,8 @@ def build_articulator(cfg: Config, mesh: Mesh, wall: WallSurface | None = None, 
     path = np.array([np.cos(a), np.sin(a), 0.0])
     normals = np.array([[-path[1], path[0], 0.0], [0.0, 0.0, 1.0]])
     guide = (cond, body.nodes[cond], np.broadcast_to(normals, (2, 2, 3)).copy(),
-             units.newton_to_dyn(cfg.jaw.guide_stiffness_n_per_cm))
+             units.newton_to_dyn(cfg.jaw.guide_stiffness_n_per_cm),
+             np.broadcast_to(path, (2, 3)).copy() if cfg.jaw.fossa_stop else None)
 
     cm = None
     use_contact = cfg.contact.enabled if contact is None else contact
@@ -332,6 +341,15 @@ def build_articulator(cfg: Config, mesh: Mesh, wall: WallSurface | None = None, 
         cm = contact_model(wall, nodes, jaw_frame, body.nodes[jaw_frame],
                            units.newton_to_dyn(cfg.contact.stiffness_n_per_cm), cfg.contact.tolerance_cm)
     g = cfg.simulation.gravity_cm_s2 if gravity is None else gravity
+    tone = np.zeros(len(names))
+    for name, fn in mc.postural_tone_n.items():
+        members = mc.groups.get(name, {name: 1.0})
+        for m, w in members.items():
+            if m not in names:
+                raise ArticError(f"config: muscles.postural_tone_n names unknown muscle '{m}'; "
+                                 f"valid: {', '.join(names + list(mc.groups))}")
+            tone[names.index(m)] += units.newton_to_dyn(fn) * w
     return _finish(mesh, body.nodes.copy(), cyl, link_mass, kappa, fixed, cfg.simulation, g, len(mesh.nodes),
                    node_sets=dict(body.node_sets), names=dict(body.names), muscles=ms,
-                   groups={k: dict(v) for k, v in mc.groups.items()}, guide_spec=guide, contact=cm, wall=wall)
+                   groups={k: dict(v) for k, v in mc.groups.items()}, guide_spec=guide, contact=cm, wall=wall,
+                   tone=tone)

@@ -33,6 +33,12 @@ def force_length(strain: np.ndarray) -> np.ndarray:
     return np.where((strain > FL_RANGE[0]) & (strain < FL_RANGE[1]), np.maximum(f, 0.0), 0.0)
 
 
+def force_length_slope(strain: np.ndarray) -> np.ndarray:
+    """d fL / d strain of :func:`force_length` (zero where fL is zero)."""
+    slope = np.polyval(np.polyder(FL_COEFFS), strain) / FL_COEFFS[-1]
+    return np.where(force_length(strain) > 0, slope, 0.0)
+
+
 @dataclass(frozen=True)
 class MuscleSet:
     names: tuple[str, ...]
@@ -43,6 +49,7 @@ class MuscleSet:
     fibre_share: np.ndarray  # (F,) share of the muscle's force
     fibre_area: np.ndarray  # (F,) thickness, cm^2
     fibre_l0: np.ndarray  # (F,) rest length, cm
+    seg_l0: np.ndarray  # (S,) rest length of each segment, cm
     k1: float  # passive stiffness coefficient, dyn/cm^2 (k1 = k1 * e)
     k2: float  # Maxwell spring, dyn/cm^2
     b2: float  # Maxwell dashpot, dyn s/cm^2
@@ -80,6 +87,7 @@ def muscle_set(names, fibres: dict[str, list[np.ndarray]], shares: dict[str, np.
                             shape=(n, s))
     return MuscleSet(names=tuple(names), seg_i=seg_i, seg_j=seg_j, seg_fibre=seg_f, fibre_muscle=np.array(f_m),
                      fibre_share=np.array(f_share), fibre_area=np.array(f_area), fibre_l0=np.array(f_l0),
+                     seg_l0=np.linalg.norm(nodes[seg_j] - nodes[seg_i], axis=1),
                      k1=k1, k2=k2, b2=b2, diff=diff, seg_sum=seg_sum, scatter=scatter)
 
 
@@ -103,6 +111,30 @@ def fibre_state(ms: MuscleSet, x: np.ndarray, activation: np.ndarray, sigma2_pre
     passive = ms.k1 * np.maximum(strain, 0.0) * strain + sigma2
     active = activation[ms.fibre_muscle] * ms.fibre_share * force_length(strain)
     return FibreState(n=n, seg_length=length, strain=strain, tension=active + ms.fibre_area * passive, sigma2=sigma2)
+
+
+def fibre_stiffness(ms: MuscleSet, fs: FibreState, activation: np.ndarray, h: float) -> np.ndarray:
+    """(F,) dT/dL (dyn/cm) of each fibre along its own length, clipped at zero for the Newton tangent.
+
+    dT/de = u s fL'(e) + A (2 k1 e+ + k2 / (1 + h k2 / b2)), and dL = L0 de.
+    """
+    e = fs.strain
+    maxwell = ms.k2 / (1.0 + h * ms.k2 / ms.b2) if h > 0 else 0.0
+    slope = (activation[ms.fibre_muscle] * ms.fibre_share * force_length_slope(e)
+             + ms.fibre_area * (2.0 * ms.k1 * np.maximum(e, 0.0) + maxwell))
+    return np.maximum(slope, 0.0) / ms.fibre_l0
+
+
+def length_gradients(ms: MuscleSet, fs: FibreState, fibres: np.ndarray, n_nodes: int) -> np.ndarray:
+    """(3N, len(fibres)) gradient of each chosen fibre's length with respect to the node positions."""
+    g = np.zeros((n_nodes, 3, len(fibres)))
+    col = np.full(ms.n_fibres, -1)
+    col[fibres] = np.arange(len(fibres))
+    seg = np.flatnonzero(col[ms.seg_fibre] >= 0)
+    c = col[ms.seg_fibre[seg]]
+    np.add.at(g, (ms.seg_j[seg], slice(None), c), fs.n[seg])
+    np.add.at(g, (ms.seg_i[seg], slice(None), c), -fs.n[seg])
+    return g.reshape(3 * n_nodes, -1)
 
 
 def muscle_forces(ms: MuscleSet, fs: FibreState) -> np.ndarray:

@@ -7,10 +7,11 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from ..geometry.hexahedra import corner_jacobians, volumes
 from .elements import strain_energy
-from .integrator import step
+from .integrator import step, total_activation
 from .model import Control, Model, State, rest_state, with_options, zero_control
 from .muscles import muscle_lengths, muscle_tensions
 from .volume import volume_energy
@@ -67,6 +68,13 @@ def frame_volumes(model: Model, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return vol, bad
 
 
+# The systems are small (a band of ~700 x 78): BLAS threads only add wake-up latency (measured: 300 ms of
+# the articulator took 1.19 s with OpenBLAS's default threads, 0.48 s with one).  Parallel work is done
+# by running whole simulations side by side instead.
+single_threaded = threadpool_limits.wrap(limits=1, user_api="blas")
+
+
+@single_threaded
 def run(model: Model, state: State, control_at: Callable[[float], Control], duration: float,
         dt: float | None = None, record_every: int = 1,
         progress: Callable[[int, int], None] | None = None) -> tuple[Trajectory, State]:
@@ -81,8 +89,7 @@ def run(model: Model, state: State, control_at: Callable[[float], Control], dura
 
     def record_muscles(st: State, act) -> None:
         if ms is not None:
-            a = act if act is not None else np.zeros(len(ms.names))
-            m_force.append(muscle_tensions(ms, st.x, a, st.sigma2))
+            m_force.append(muscle_tensions(ms, st.x, total_activation(model, act), st.sigma2))
             m_len.append(muscle_lengths(ms, st.x))
 
     record_muscles(state, control_at(state.t).activation if ms is not None else None)
@@ -126,6 +133,7 @@ def run(model: Model, state: State, control_at: Callable[[float], Control], dura
     return traj, state
 
 
+@single_threaded
 def equilibrate(model: Model, state: State, control: Control, dt: float = 0.01, tol: float = 1e-3,
                 max_time: float = 5.0) -> tuple[State, bool]:
     """Step under constant ``control`` until every speed is below ``tol`` cm/s.
