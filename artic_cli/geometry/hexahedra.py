@@ -78,6 +78,18 @@ def corner_jacobians(x: np.ndarray, bricks: np.ndarray) -> np.ndarray:
     return _dets(_jacobians(x, bricks, _D_CORNER))
 
 
+def corner_jacobians_at(x: np.ndarray, bricks: np.ndarray, which_brick: np.ndarray, which_corner: np.ndarray,
+                        ) -> tuple[np.ndarray, np.ndarray]:
+    """det J at chosen (brick, corner) pairs (K,) and its gradient with respect to the brick's nodes (K,8,3)."""
+    j = _jacobians(x, bricks[which_brick], _D_CORNER)  # (l, i, K, corner)
+    k = np.arange(len(which_brick))
+    jj = j[:, :, k, which_corner]  # (l, i, K)
+    cof = np.array([_cross(jj[1], jj[2]), _cross(jj[2], jj[0]), _cross(jj[0], jj[1])])  # (l, i, K)
+    det = (jj[0] * cof[0]).sum(axis=0)
+    grad = np.einsum("lik,kal->kai", cof, _DN_CORNER[which_corner])
+    return det, grad
+
+
 def inverted_bricks(x: np.ndarray, bricks: np.ndarray) -> np.ndarray:
     """Indices of bricks turned inside out (a non-positive corner Jacobian)."""
     return np.flatnonzero((corner_jacobians(x, bricks) <= 0.0).any(axis=1))

@@ -27,7 +27,8 @@ from .assembly import add_low_rank, factorize, pair_blocks
 from .contact import ContactPlanes, contact_planes, enforce
 from .model import Control, Model, State
 from .muscles import FibreState, fibre_state, fibre_stiffness, length_gradients, muscle_forces
-from .volume import volume_forces
+from ..geometry.hexahedra import corner_jacobians
+from .volume import GUARD_FRACTION, corner_guard, volume_forces
 
 _EYE = np.eye(3)
 _MAX_INCREMENT = 0.2  # cm: the largest node move one Newton iteration may make
@@ -49,6 +50,9 @@ def internal_forces(model: Model, x: np.ndarray, v: np.ndarray | None = None,
     if model.volume_constraint:
         fv, vol, grad = volume_forces(x[: model.n_tongue], model.bricks, model.brick_v0, model.kappa)
         f[: model.n_tongue] += fv
+    if model.corner_j0 is not None:
+        fg, _ = corner_guard(x[: model.n_tongue], model.bricks, model.corner_j0, model.guard_weight)
+        f[: model.n_tongue] += fg
     return f, cs, vol, grad
 
 
@@ -72,6 +76,14 @@ def total_activation(model: Model, activation: np.ndarray | None) -> np.ndarray 
         return None
     act = np.zeros(len(model.muscles.names)) if activation is None else activation
     return act + model.tone if model.tone is not None else act
+
+
+def guarded_corners(model: Model, x: np.ndarray) -> tuple:
+    """(brick, corner) pairs on which the inversion guard acts."""
+    if model.corner_j0 is None:
+        return ()
+    b, c = np.nonzero(corner_jacobians(x[: model.n_tongue], model.bricks) / model.corner_j0 < GUARD_FRACTION)
+    return tuple(zip(b.tolist(), c.tolist()))
 
 
 def guide_stop(gd, x: np.ndarray) -> np.ndarray:
@@ -156,6 +168,14 @@ def rank_one_terms(model: Model, x: np.ndarray, fs: FibreState | None, act: np.n
             v[planes.jaw_nodes, :, c] -= n[c] / len(planes.jaw_nodes)
         cols.append(v.reshape(n3, -1))
         ks.append(np.full(len(nodes), model.contact.stiffness))
+    if model.corner_j0 is not None:
+        _, guard = corner_guard(x[: model.n_tongue], model.bricks, model.corner_j0, model.guard_weight)
+        if guard is not None:
+            b, _, g, w = guard
+            v = np.zeros((model.n_nodes, 3, len(b)))
+            np.add.at(v, (model.bricks[b], slice(None), np.arange(len(b))[:, None]), g)
+            cols.append(v.reshape(n3, -1))
+            ks.append(w)
     stop = guide_stop(model.guide, x)
     if stop.any():
         gd = model.guide
@@ -248,7 +268,8 @@ def _step_once(model: Model, state: State, control: Control, h: float) -> State:
             f += muscle_forces(ms, fs)
         fc, active, _ = contact_forces(model, x, planes)
         f += fc
-        active_key = (None if planes is None else tuple(planes.nodes[active]), tuple(guide_stop(model.guide, x)))
+        active_key = (None if planes is None else tuple(planes.nodes[active]), tuple(guide_stop(model.guide, x)),
+                      guarded_corners(model, x))
         if factor is not None and active_key != factor.terms_key:
             factor = None  # contact set changed: keep the band, redo the small Woodbury part
         resid = (model.mass @ a - f - f_ext).ravel()[free]

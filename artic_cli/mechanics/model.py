@@ -24,7 +24,7 @@ from .. import units
 from ..config import Config, Simulation, TissueMaterial
 from ..errors import ArticError
 from ..geometry.anatomy import JAW_MUSCLES, LINK_KINDS, TONGUE_MUSCLES, Body, build_body
-from ..geometry.hexahedra import volumes
+from ..geometry.hexahedra import corner_jacobians, volumes
 from ..geometry.mesh import Mesh
 from ..geometry.wall import WallSurface
 from .assembly import BandFactor, BandPattern, band_pattern
@@ -89,6 +89,8 @@ class Model:
     contact_index: np.ndarray | None = None  # (P,3,3) for contact nodes
     wall: WallSurface | None = None
     tone: np.ndarray | None = None  # (M,) postural muscle forces, dyn, added to every control's
+    corner_j0: np.ndarray | None = None  # (B,8) rest corner Jacobians (inversion guard)
+    guard_weight: np.ndarray | None = None  # (B,) guard stiffness w = bulk x V0 / 8, erg
 
     @property
     def n_nodes(self) -> int:
@@ -187,8 +189,11 @@ def _consistent_mass(i, j, m, n):
 
 
 def _finish(mesh: Mesh, rest: np.ndarray, cyl: CylinderSet, link_mass: np.ndarray, kappa: np.ndarray,
-            fixed: np.ndarray, sim: Simulation, gravity: float, n_core: int, **extra) -> Model:
+            fixed: np.ndarray, sim: Simulation, gravity: float, n_core: int, bulk: float, **extra) -> Model:
     n = len(rest)
+    v0 = volumes(mesh.nodes, mesh.bricks)
+    extra["corner_j0"] = corner_jacobians(mesh.nodes, mesh.bricks)
+    extra["guard_weight"] = bulk * v0 / 8.0
     mass = _consistent_mass(cyl.i, cyl.j, link_mass, n)
     node_mass = np.asarray(mass.sum(axis=1)).ravel()
     pairs = [cyl.i[:, None], cyl.j[:, None]]
@@ -214,7 +219,7 @@ def _finish(mesh: Mesh, rest: np.ndarray, cyl: CylinderSet, link_mass: np.ndarra
                                index=pattern.diagonal_index(nodes), path=path)
     if extra.get("contact") is not None:
         extra["contact_index"] = pattern.diagonal_index(extra["contact"].nodes)
-    return Model(mesh=mesh, rest=rest, cyl=cyl, bricks=mesh.bricks, brick_v0=volumes(mesh.nodes, mesh.bricks),
+    return Model(mesh=mesh, rest=rest, cyl=cyl, bricks=mesh.bricks, brick_v0=v0,
                  kappa=kappa, mass=mass, node_mass=node_mass, gravity=np.array([0.0, -gravity, 0.0]), fixed=fixed,
                  pattern=pattern, cyl_index=cyl_index, brick_index=brick_index, mass_matrix=mass_matrix,
                  scatter=scatter, options=solver_options(sim), **extra)
@@ -239,7 +244,7 @@ def build_model(mesh: Mesh, tissue: TissueMaterial, sim: Simulation, *,
     link_mass = tissue.density_g_cm3 * mesh.areas * cyl.l0  # the paper's volumes carry the mass
     g = sim.gravity_cm_s2 if gravity is None else gravity
     return _finish(mesh, mesh.nodes.copy(), cyl, link_mass, kappa, fixed_dofs, sim, g, n,
-                   node_sets=dict(mesh.node_sets))
+                   bulk_ratio * scale * e0, node_sets=dict(mesh.node_sets))
 
 
 def _links(body: Body, cfg: Config, tissue_scale: float) -> tuple[CylinderSet, np.ndarray]:
@@ -350,6 +355,7 @@ def build_articulator(cfg: Config, mesh: Mesh, wall: WallSurface | None = None, 
                                  f"valid: {', '.join(names + list(mc.groups))}")
             tone[names.index(m)] += units.newton_to_dyn(fn) * w
     return _finish(mesh, body.nodes.copy(), cyl, link_mass, kappa, fixed, cfg.simulation, g, len(mesh.nodes),
+                   bulk_ratio * scale * e0,
                    node_sets=dict(body.node_sets), names=dict(body.names), muscles=ms,
                    groups={k: dict(v) for k, v in mc.groups.items()}, guide_spec=guide, contact=cm, wall=wall,
                    tone=tone)

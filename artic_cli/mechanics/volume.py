@@ -18,7 +18,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geometry.hexahedra import volume_gradients, volumes
+from ..geometry.hexahedra import corner_jacobians, corner_jacobians_at, volume_gradients, volumes
+
+# Inversion guard: a corner whose Jacobian falls below this fraction of its rest value is pushed back by
+# U = w / 2 (GUARD_FRACTION - J / J0)^2, w = bulk modulus x V0 / 8 (one eighth of the brick per corner).
+# It is zero in ordinary motion and keeps bricks from turning inside out under extreme shear
+# (7 N antagonists pulling the midsagittal and parasagittal planes apart).
+GUARD_FRACTION = 0.25
 
 
 def volume_forces(x: np.ndarray, bricks: np.ndarray, v0: np.ndarray, kappa: np.ndarray):
@@ -35,3 +41,20 @@ def volume_forces(x: np.ndarray, bricks: np.ndarray, v0: np.ndarray, kappa: np.n
 def volume_energy(x: np.ndarray, bricks: np.ndarray, v0: np.ndarray, kappa: np.ndarray) -> float:
     vol = volumes(x, bricks)
     return float((0.5 * kappa * (vol - v0) ** 2 / v0).sum())
+
+
+def corner_guard(x: np.ndarray, bricks: np.ndarray, j0: np.ndarray, weight: np.ndarray):
+    """Guard forces (N,3) and, for the tangent, the active corners' (bricks (K,), d(J/J0)/dx (K,8,3), w (K,)).
+
+    ``None`` for the second item when no corner is near inversion."""
+    f = np.zeros_like(x)
+    ratio = corner_jacobians(x, bricks) / j0
+    b, c = np.nonzero(ratio < GUARD_FRACTION)
+    if len(b) == 0:
+        return f, None
+    _, grad = corner_jacobians_at(x, bricks, b, c)
+    g = grad / j0[b, c][:, None, None]
+    w = weight[b]
+    contrib = (w * (GUARD_FRACTION - ratio[b, c]))[:, None, None] * g  # -dU/dx
+    np.add.at(f, bricks[b], contrib)
+    return f, (b, c, g, w)
