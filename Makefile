@@ -12,7 +12,7 @@ SRC    := $(shell find artic_cli -name '*.py') pyproject.toml
 SCHED  := configs/schedules
 SIMS   := $(OUT)/sims
 
-.PHONY: setup mesh sims cuboid figures paper test bench clean
+.PHONY: setup mesh sims cuboid experiments figures paper test bench clean
 .DELETE_ON_ERROR:
 
 setup: $(VENV)/.installed
@@ -40,16 +40,28 @@ $(SIMS)/%.h5: $(SCHED)/%.yaml $(OUT)/mesh.h5
 
 # the whole articulator (section III): muscle schedules
 $(SIMS)/fig4_%.h5: $(SCHED)/fig4_%.yaml $(OUT)/mesh.h5
-	$(ARTIC) simulate --schedule $< --mesh $(OUT)/mesh.h5 --config $(CONFIG) --out $@ --plot $(REPORT)/fig4_$*.png
+	$(ARTIC) simulate --schedule $< --mesh $(OUT)/mesh.h5 --config $(CONFIG) --out $@ --plot $(REPORT)/fig4_$*.png \
+	  --animate $(REPORT)/fig4_$*.gif
+
+$(SIMS)/art_%.h5: $(SCHED)/art_%.yaml $(OUT)/mesh.h5
+	$(ARTIC) simulate --schedule $< --mesh $(OUT)/mesh.h5 --config $(CONFIG) --out $@ --plot $(REPORT)/art_$*.png
+
+# the paper's numeric experiments (section III), each a JSON table
+EXPS := jaw-ep fig4 muscle-directions k-closure stress
+EXP_FILES := $(EXPS:%=$(OUT)/experiments/%.json)
+experiments: $(EXP_FILES)
+$(OUT)/experiments/%.json: $(OUT)/mesh.h5
+	$(ARTIC) experiment $* --mesh $(OUT)/mesh.h5 --config $(CONFIG) --out $@
 
 sims: $(SIMS)/gravity.h5 $(SIMS)/pull_2n.h5 $(SIMS)/pull_2n_novol.h5 $(SIMS)/stress_7n.h5 \
-      $(SIMS)/fig4_ggp.h5 $(SIMS)/fig4_sg.h5
+      $(SIMS)/fig4_ggp.h5 $(SIMS)/fig4_sg.h5 $(SIMS)/art_sg_jo.h5
 
 figures: mesh sims
 
 paper: $(REPORT)/paper.md
 $(REPORT)/paper.md: $(OUT)/mesh.h5 $(OUT)/cuboid.json $(SIMS)/gravity.h5 $(SIMS)/pull_2n.h5 \
-                    $(SIMS)/pull_2n_novol.h5 $(SIMS)/stress_7n.h5 $(SIMS)/fig4_ggp.h5 $(SIMS)/fig4_sg.h5
+                    $(SIMS)/pull_2n_novol.h5 $(SIMS)/stress_7n.h5 $(SIMS)/fig4_ggp.h5 $(SIMS)/fig4_sg.h5 \
+                    $(SIMS)/art_sg_jo.h5 $(EXP_FILES)
 	$(ARTIC) report --data $(OUT) --out $@
 
 # --- checks ---------------------------------------------------------------
@@ -61,4 +73,4 @@ bench: setup
 	$(PY) benchmarks/bench_articulator.py
 
 clean:
-	rm -rf $(OUT)/*.h5 $(OUT)/*.json $(SIMS) $(REPORT)/*.png $(REPORT)/paper.md
+	rm -rf $(OUT)/*.h5 $(OUT)/*.json $(SIMS) $(OUT)/experiments $(REPORT)/*.png $(REPORT)/*.gif $(REPORT)/paper.md

@@ -69,6 +69,76 @@ def tissue_rows(data: Path) -> list[Row]:
     return rows
 
 
+def _experiment(data: Path, name: str) -> dict[str, dict]:
+    path = data / "experiments" / f"{name}.json"
+    if not path.is_file():
+        raise ArticError(f"{path} not found; run 'artic experiment {name} --out {path}' (or 'make paper')")
+    try:
+        doc = json.loads(path.read_text())
+        return {r["name"]: r for r in doc["rows"]}
+    except (ValueError, KeyError, TypeError):
+        raise ArticError(f"{path} is not an experiment table; delete it and rerun 'make paper'") from None
+
+
+def _audit_ok(rows: dict[str, dict]) -> tuple[bool, str]:
+    vol = next(r for k, r in rows.items() if k.startswith("largest tongue volume change"))
+    wall = rows["largest distance of a node beyond the wall"]
+    inv = rows["inverted bricks (most in any frame)"]
+    ok = vol["ours"] <= 0.3 and wall["ours"] <= wall["paper"] + 1e-12 and inv["ours"] == 0
+    return ok, f"volume change <= {vol['ours']:.3f} %, <= {wall['ours']:.4f} cm beyond the wall, {inv['ours']:.0f} inverted"
+
+
+def articulator_rows(data: Path) -> list[Row]:
+    rows: list[Row] = []
+    jaw = _experiment(data, "jaw-ep")
+    eps = [r for k, r in jaw.items() if k.startswith(("JO", "JC"))]
+    for r in eps:
+        ratio = r["ours"] / r["paper"]
+        rows.append(Row(f"Jaw EP, {r['name']} for 300 ms", f"{r['paper']:+.2f} cm", f"{r['ours']:+.3f} cm",
+                        _verdict(0.5 <= ratio <= 2.0, f"x{ratio:.2f}, goal within a factor of two")))
+    jo = [r["ours"] for r in eps if r["name"].startswith("JO")]
+    jc = [r["ours"] for r in eps if r["name"].startswith("JC")]
+    mono = all(b < a for a, b in zip(jo, jo[1:])) and all(b > a for a, b in zip(jc, jc[1:]))
+    rows.append(Row("Jaw EPs monotonic in JO and JC force", "yes", "yes" if mono else "no",
+                    _verdict(mono, f"{len(jo)} JO and {len(jc)} JC levels")))
+    f4 = _experiment(data, "fig4")
+    for cp, paper in (("tip", 41), ("dorsum", 30), ("jaw", 8)):
+        r = f4[f"SG+JO {cp} peak speed"]
+        ratio = r["ours"] / paper
+        goal = cp != "jaw"
+        rows.append(Row(f"Fig. 4 / Table II: SG 4 N + JO 3 N, {cp} peak speed in 20 ms", f"{paper} cm/s",
+                        f"{r['ours']:.1f} cm/s", _verdict(0.5 <= ratio <= 2.0, f"x{ratio:.2f}" +
+                                                         (", goal within a factor of two" if goal else ""))))
+    md = _experiment(data, "muscle-directions")
+    agree, differ = [], []
+    for name, r in md.items():
+        if "from the paper's" in r["note"]:
+            err = float(r["note"].split(",")[1].split("deg")[0])
+            (agree if err <= 45 else differ).append(f"{name} {err:.0f} deg")
+    rows.append(Row("Section IV.A.1: 300-ms displacement direction of each muscle at 4 N, where the paper is definite",
+                    "the stated directions", f"{len(agree)} of {len(agree) + len(differ)} within 45 deg",
+                    _verdict(not differ, "differing: " + ", ".join(differ) if differ else "all within 45 deg")))
+    kc = _experiment(data, "k-closure")
+    r = kc["SG force at first dorsum-palate contact"]
+    rows.append(Row("SG force at which the dorsum first touches the palate (jaw at rest)", "about 1.0 N",
+                    "none up to 4 N" if r["ours"] is None else f"{r['ours']:g} N",
+                    _verdict(r["ours"] is not None and 0.5 <= r["ours"] <= 2.0, r["note"] or "goal about 1 N")))
+    st = _experiment(data, "stress")
+    ok, detail = _audit_ok(st)
+    rows.append(Row("7 N on GGp, SG, HG, SL, IL at once for 500 ms", "no divergence",
+                    "finite" if st["finite positions"]["ours"] == 1 else "NaN", _verdict(ok, detail)))
+    for name in ("jaw-ep", "fig4", "muscle-directions", "k-closure"):
+        ok, detail = _audit_ok(_experiment(data, name))
+        rows.append(Row(f"Every run of '{name}': volume, wall, bricks", "volume change about 0.3 %", detail,
+                        _verdict(ok, "goal: volume <= 0.3 %, <= 0.01 cm beyond the wall, none inverted")))
+    with _sim(data / "sims" / "art_sg_jo.h5") as f:
+        ratio = float(f.attrs["wall_time_s"]) / float(f["time"][-1])
+    rows.append(Row("Articulator speed (wall time per simulated second; SG 4 N + JO 3 N for 300 ms)", "about 40",
+                    f"{ratio:.2f}", _verdict(ratio <= 0.5, f"goal <= 0.5, {40 / ratio:.0f} times faster than the "
+                                                           "paper; make bench splits the time")))
+    return rows
+
+
 def write_report(data: Path | str = "data", out: Path | str = "reports/paper.md") -> Path:
     data, out = Path(data), Path(out)
     rows = tissue_rows(data)
@@ -79,5 +149,10 @@ def write_report(data: Path | str = "data", out: Path | str = "reports/paper.md"
              "![Model configuration (Fig. 1)](fig1_mesh.png)", "",
              "| item | paper | ours | verdict |", "|---|---|---|---|"]
     lines += [f"| {r.item} | {r.paper} | {r.ours} | {r.verdict} |" for r in rows]
+    lines += ["", "## Muscles, jaw-hyoid complex and contact (section III)", "",
+              "![SG 4 N + JO 3 N, 20 ms (Fig. 4 right)](fig4_sg.png) ![GGp 4 N + JO 3 N, 20 ms (Fig. 4 left)]"
+              "(fig4_ggp.png)", "", "Animations: [fig4_sg.gif](fig4_sg.gif), [fig4_ggp.gif](fig4_ggp.gif).", "",
+              "| item | paper | ours | verdict |", "|---|---|---|---|"]
+    lines += [f"| {r.item} | {r.paper} | {r.ours} | {r.verdict} |" for r in articulator_rows(data)]
     lines.append("")
     return write_text_atomic(out, "\n".join(lines))

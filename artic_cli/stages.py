@@ -79,7 +79,7 @@ def simulate(schedule: Path | str, duration: float | None = None, dt: float | No
              mesh: Path | str = "data/mesh.h5", config: Path | str | None = None, out: Path | str | None = None,
              volume_constraint: bool | None = None, plot: Path | str | None = None,
              progress: Callable[[int, int], None] | None = None, tongue_only: bool = False,
-             contact: bool | None = None) -> SimResult:
+             contact: bool | None = None, animate: Path | str | None = None) -> SimResult:
     """Run the model under a schedule of muscle forces and loads from its rest posture; write ``out`` (HDF5)."""
     _positive("--duration", duration)
     _positive("--dt", dt)
@@ -104,6 +104,10 @@ def simulate(schedule: Path | str, duration: float | None = None, dt: float | No
         from .plots.simulation import plot_simulation
 
         plot_simulation(traj, model, wall, plot, title=f"{Path(schedule).stem}: start and end shapes")
+    if animate:
+        from .plots.animation import animate_simulation
+
+        animate_simulation(traj, model, wall, animate)
     return SimResult(out, traj, model, float(np.abs(traj.volume_change).max()))
 
 

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from artic_cli.errors import ArticError
-from artic_cli.experiments.paper import PAPER_DIRECTIONS, jaw_ep, muscle_directions
+from artic_cli.experiments.paper import PAPER_DIRECTIONS, fig4, jaw_ep, muscle_directions, stress
 from artic_cli.mechanics.contact import wall_query
 from artic_cli.mechanics.loads import activation_vector
 from artic_cli.mechanics.model import Control, build_articulator
@@ -86,8 +86,44 @@ def test_jaw_equilibria_move_monotonically_with_force(jaw_rows):
 
 
 def test_jaw_equilibria_within_a_factor_of_two_of_the_paper(jaw_rows):
-    for r in jaw_rows:
+    eps = [r for r in jaw_rows if r.name.startswith(("JO", "JC"))]
+    assert len(eps) == 8
+    for r in eps:
         assert 0.5 <= r.ours / r.paper <= 2.0, r
+
+
+@pytest.fixture(scope="module")
+def fig4_rows(art):
+    return {r.name: r for r in fig4(art)}
+
+
+def test_fig4_sg_peak_speeds_within_a_factor_of_two_of_table_ii(fig4_rows):
+    for cp in ("tip", "dorsum"):
+        r = fig4_rows[f"SG+JO {cp} peak speed"]
+        assert 0.5 <= r.ours / r.paper <= 2.0, r
+
+
+def _audit(rows):
+    by = {r.name.split(" (")[0]: r for r in rows}
+    return (by["largest tongue volume change"].ours, by["largest distance of a node beyond the wall"].ours,
+            by["inverted bricks"].ours)
+
+
+@pytest.mark.parametrize("which", ["jaw_rows", "fig4_rows", "directions"])
+def test_every_run_keeps_volume_wall_and_bricks(which, request):
+    rows = request.getfixturevalue(which)
+    rows = list(rows.values()) if isinstance(rows, dict) else rows
+    volume_pct, beyond_cm, inverted = _audit(rows)
+    assert volume_pct <= 0.3
+    assert beyond_cm <= 0.01 + 1e-12
+    assert inverted == 0
+
+
+def test_7n_stress_is_finite_upright_and_keeps_volume(art):
+    rows = {r.name: r for r in stress(art)}
+    assert rows["finite positions"].ours == 1.0
+    volume_pct, beyond_cm, inverted = _audit(list(rows.values()))
+    assert volume_pct <= 0.3 and beyond_cm <= 0.01 + 1e-12 and inverted == 0
 
 
 @pytest.fixture(scope="module")

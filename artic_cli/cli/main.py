@@ -91,6 +91,7 @@ def simulate_cmd(
     plot: Optional[Path] = typer.Option(None, "--plot", help="Draw start and end shapes (PNG)."),
     tongue_only: bool = typer.Option(False, "--tongue-only", help="The tongue alone, its fixed node sets held."),
     contact: Optional[bool] = typer.Option(None, "--contact/--no-contact", help="Override the config's wall contact."),
+    animate: Optional[Path] = typer.Option(None, "--animate", help="Also write a short animation (GIF)."),
 ):
     """Move the model under a schedule of muscle forces and loads; write trajectories."""
     from ..stages import simulate
@@ -99,16 +100,17 @@ def simulate_cmd(
     args = (schedule, duration, dt, mesh, config, out, volume_constraint, plot)
     if bar is not None:
         with bar:
-            r = simulate(*args, update, tongue_only=tongue_only, contact=contact)
+            r = simulate(*args, update, tongue_only=tongue_only, contact=contact, animate=animate)
     else:
-        r = simulate(*args, tongue_only=tongue_only, contact=contact)
+        r = simulate(*args, tongue_only=tongue_only, contact=contact, animate=animate)
     t = r.trajectory
     sim_time = t.time[-1] - t.time[0]
     out_console.print(
         f"wrote {r.path}: {t.stats['steps']} steps of {t.stats['dt'] * 1e3:g} ms, wall {t.stats['wall_time_s']:.3f} s "
         f"({t.stats['wall_time_s'] / sim_time:.3f} s per simulated s), max |volume change| "
         f"{100 * r.max_volume_change:.3f} % (constraint {'on' if r.model.volume_constraint else 'off'}), "
-        f"inverted bricks {int(t.inverted.max())}" + (f"; figure {plot}" if plot else ""), highlight=False)
+        f"inverted bricks {int(t.inverted.max())}" + (f"; figure {plot}" if plot else "")
+        + (f"; animation {animate}" if animate else ""), highlight=False)
 
 
 @validate_app.command("cuboid")
@@ -156,15 +158,22 @@ def experiment_cmd(
     mesh: Path = typer.Option(Path("data/mesh.h5"), "--mesh", help="Mesh artefact from build-mesh."),
     config: Optional[Path] = typer.Option(None, "--config", help="Config the mesh was built from."),
     as_json: bool = typer.Option(False, "--json", help="Print the table as JSON."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Also write the rows as JSON to this file."),
 ):
     """Reproduce one of the paper's numeric experiments, ours beside the paper's."""
+    from ..config import config_hash
     from ..experiments.paper import EXPERIMENTS, rows_as_dicts
+    from ..io.store import file_hash, write_text_atomic
     from ..stages import load_model
 
     if name not in EXPERIMENTS:
         raise ArticError(f"unknown experiment '{name}'; valid: {', '.join(EXPERIMENTS)}")
-    model, _, _ = load_model(mesh, config)
+    model, cfg, _ = load_model(mesh, config)
     rows = EXPERIMENTS[name](model)
+    if out is not None:
+        doc = {"experiment": name, "config_hash": config_hash(cfg), "mesh_sha256": file_hash(mesh),
+               "rows": rows_as_dicts(rows)}
+        write_text_atomic(out, json.dumps(doc, indent=1))
     if as_json:
         out_console.print_json(json.dumps(rows_as_dicts(rows)))
         return
@@ -172,7 +181,8 @@ def experiment_cmd(
     for col in ("quantity", "ours", "paper", "unit", "note"):
         table.add_column(col, justify="left" if col in ("quantity", "note") else "right")
     for r in rows:
-        table.add_row(r.name, f"{r.ours:.3g}", "" if r.paper is None else f"{r.paper:g}", r.unit, r.note)
+        table.add_row(r.name, "n/a" if r.ours is None else f"{r.ours:.3g}", "" if r.paper is None else f"{r.paper:g}",
+                      r.unit, r.note)
     out_console.print(table)
 
 

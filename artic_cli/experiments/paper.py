@@ -11,6 +11,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from ..mechanics.contact import wall_query
 from ..mechanics.loads import activation_vector
 from ..mechanics.model import Control, Model
 from ..mechanics.simulate import run, settle
@@ -53,6 +54,35 @@ def _control(model: Model, forces_n: dict[str, float]) -> Control:
     return Control(force=np.zeros((model.n_nodes, 3)), activation=activation_vector(model, forces_n))
 
 
+class Audit:
+    """Worst volume change, wall penetration and inverted-brick count over every run of an experiment."""
+
+    def __init__(self, model: Model):
+        self.model = model
+        self.volume = 0.0
+        self.penetration = -np.inf
+        self.inverted = 0
+        self.runs = 0
+
+    def run(self, rest, forces_n: dict[str, float], duration: float):
+        ctl = _control(self.model, forces_n)
+        traj, end = run(self.model, rest, lambda t: ctl, duration)
+        self.runs += 1
+        self.volume = max(self.volume, float(np.abs(traj.volume_change).max()))
+        self.inverted = max(self.inverted, int(traj.inverted.max()))
+        if self.model.contact is not None:
+            for x in traj.x:
+                self.penetration = max(self.penetration, float(wall_query(self.model.contact, x)[2].max()))
+        return traj, end
+
+    def rows(self) -> list[Row]:
+        tol = self.model.contact.tolerance if self.model.contact is not None else None
+        return [Row(f"largest tongue volume change ({self.runs} runs)", 100 * self.volume, 0.3, "%"),
+                Row("largest distance of a node beyond the wall", max(self.penetration, 0.0), tol, "cm",
+                    "bound: the contact tolerance"),
+                Row("inverted bricks (most in any frame)", float(self.inverted), 0.0, "count")]
+
+
 def _points(model: Model) -> dict[str, int]:
     return {k: int(model.node_sets[k][0]) for k in ("tip", "dorsum", "jaw")}
 
@@ -60,39 +90,39 @@ def _points(model: Model) -> dict[str, int]:
 def jaw_ep(model: Model, duration: float = 0.3) -> list[Row]:
     rest = settle(model)
     jaw = _points(model)["jaw"]
+    audit = Audit(model)
     rows = []
     for group, pairs in PAPER_JAW_EP.items():
         for force, paper in pairs:
-            ctl = _control(model, {group: force})
-            _, end = run(model, rest, lambda t: ctl, duration)
+            _, end = audit.run(rest, {group: force}, duration)
             rows.append(Row(f"{group} {force:g} N", float(end.x[jaw, 1] - rest.x[jaw, 1]), paper, "cm",
                             f"residual speed {np.linalg.norm(end.v[jaw]):.2f} cm/s"))
-    return rows
+    return rows + audit.rows()
 
 
 def fig4(model: Model) -> list[Row]:
     rest = settle(model)
     pts = _points(model)
+    audit = Audit(model)
     rows = []
     for muscle in ("GGp", "SG"):
-        ctl = _control(model, {muscle: 4.0, "JO": 3.0})
-        traj, _ = run(model, rest, lambda t: ctl, 0.02)
+        traj, _ = audit.run(rest, {muscle: 4.0, "JO": 3.0}, 0.02)
         for name, i in pts.items():
             disp = float(np.linalg.norm(traj.x[-1, i, :2] - traj.x[0, i, :2]))
             speed = float(np.linalg.norm(traj.v[:, i, :2], axis=1).max())
             paper = PAPER_FIG4_SG[name] if muscle == "SG" else None
             rows.append(Row(f"{muscle}+JO {name} displacement", disp, None, "cm"))
             rows.append(Row(f"{muscle}+JO {name} peak speed", speed, paper, "cm/s"))
-    return rows
+    return rows + audit.rows()
 
 
 def muscle_directions(model: Model, force: float = 4.0, duration: float = 0.3) -> list[Row]:
     rest = settle(model)
     pts = _points(model)
+    audit = Audit(model)
     rows = []
     for muscle in ("GGa", "GGm", "GGp", "HG", "SG", "SL", "IL", "T", "V", "GH", "MH", "T-SL"):
-        ctl = _control(model, {muscle: force})
-        _, end = run(model, rest, lambda t: ctl, duration)
+        _, end = audit.run(rest, {muscle: force}, duration)
         for cp in ("tip", "dorsum"):
             d = end.x[pts[cp], :2] - rest.x[pts[cp], :2]
             paper = PAPER_DIRECTIONS.get(muscle, {}).get(cp)
@@ -104,40 +134,50 @@ def muscle_directions(model: Model, force: float = 4.0, duration: float = 0.3) -
             rows.append(Row(f"{muscle} {cp}", float(np.linalg.norm(d)), None, "cm",
                             f"direction {angle:+.0f} deg" + (f", {err:.0f} deg from the paper's" if err is not None
                                                              else ", paper: no definite direction")))
-    return rows
+    return rows + audit.rows()
 
 
 def k_closure(model: Model, forces=(0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0, 4.0), duration: float = 0.3) -> list[Row]:
     """Smallest SG force at which the dorsum region touches the palate (jaw at rest)."""
     rest = settle(model)
     dorsum_region = set(model.node_sets["dorsum_region"].tolist())
-    found = None
+    dorsum = _points(model)["dorsum"]
+    audit = Audit(model)
+    found, gap = None, None
     for force in forces:
-        ctl = _control(model, {"SG": force})
-        traj, _ = run(model, rest, lambda t: ctl, duration)
+        traj, end = audit.run(rest, {"SG": force}, duration)
         if any(dorsum_region & set(c.tolist()) for c in traj.contact_nodes):
             found = force
             break
+        gap = float(-wall_query(model.contact, end.x, np.array([dorsum]))[2][0])
+    note = "" if found is not None else f"no contact up to {forces[-1]:g} N; dorsum still {gap:.2f} cm from the wall"
     return [Row("SG force at first dorsum-palate contact", float("nan") if found is None else found, 1.0, "N",
-                "" if found is not None else f"no contact up to {forces[-1]:g} N")]
+                note)] + audit.rows()
 
 
 def stress(model: Model, force: float = 7.0, duration: float = 0.5) -> list[Row]:
     rest = settle(model)
-    ctl = _control(model, {m: force for m in ("GGp", "SG", "HG", "SL", "IL")})
-    traj, _ = run(model, rest, lambda t: ctl, duration)
-    return [Row("finite positions", float(np.isfinite(traj.x).all()), 1.0, "bool"),
-            Row("inverted bricks (max)", float(traj.inverted.max()), 0.0, "count"),
-            Row("volume change (max)", float(100 * np.abs(traj.volume_change).max()), 0.3, "%"),
-            Row("nodes projected back onto the wall", float(traj.projected.sum()), None, "count")]
+    audit = Audit(model)
+    traj, _ = audit.run(rest, {m: force for m in STRESS_MUSCLES}, duration)
+    return [Row("finite positions", float(np.isfinite(traj.x).all()), 1.0, "bool",
+                f"{force:g} N on each of {', '.join(STRESS_MUSCLES)} for {duration * 1e3:g} ms"),
+            Row("nodes projected back onto the wall", float(traj.projected.sum()), None, "count")] + audit.rows()
 
+
+STRESS_MUSCLES = ("GGp", "SG", "HG", "SL", "IL")
 
 EXPERIMENTS = {"jaw-ep": jaw_ep, "fig4": fig4, "muscle-directions": muscle_directions, "k-closure": k_closure,
                "stress": stress}
 
 
 def rows_as_dicts(rows: list[Row]) -> list[dict]:
-    return [asdict(r) for r in rows]
+    """Plain dicts for JSON (a NaN becomes null: JSON has no NaN)."""
+    out = []
+    for r in rows:
+        d = asdict(r)
+        d["ours"] = None if d["ours"] is None or not np.isfinite(d["ours"]) else d["ours"]
+        out.append(d)
+    return out
 
 
 __all__ = ["EXPERIMENTS", "Row", "rows_as_dicts"]

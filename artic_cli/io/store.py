@@ -29,24 +29,38 @@ from ..geometry.wall import PARTS, WallSurface
 SCHEMA_VERSION = 1
 
 
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
 @contextlib.contextmanager
-def atomic_h5(path: Path | str, kind: str, cfg_hash: str = "") -> Iterator[h5py.File]:
-    """Open a temporary HDF5 file that replaces ``path`` only on success."""
+def atomic_path(path: Path | str, suffix: str = ".tmp") -> Iterator[Path]:
+    """A temporary file beside ``path`` that replaces it (with ordinary permissions) only on success."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
     os.close(fd)
     try:
-        with h5py.File(tmp, "w") as f:
-            f.attrs.update({"kind": kind, "schema_version": SCHEMA_VERSION, "package_version": __version__,
-                            "config_hash": cfg_hash,
-                            "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")})
-            yield f
+        yield Path(tmp)
+        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; artefacts are for sharing
         os.replace(tmp, path)
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
         raise
+
+
+@contextlib.contextmanager
+def atomic_h5(path: Path | str, kind: str, cfg_hash: str = "") -> Iterator[h5py.File]:
+    """Open a temporary HDF5 file that replaces ``path`` only on success."""
+    with atomic_path(path) as tmp:
+        with h5py.File(tmp, "w") as f:
+            f.attrs.update({"kind": kind, "schema_version": SCHEMA_VERSION, "package_version": __version__,
+                            "config_hash": cfg_hash,
+                            "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")})
+            yield f
 
 
 def open_artifact(path: Path | str, kind: str, hint: str) -> h5py.File:
@@ -145,14 +159,6 @@ def file_hash(path: Path | str) -> str:
 def write_text_atomic(path: Path | str, text: str) -> Path:
     """Write a text artefact through a temporary file and a rename."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w") as fh:
-            fh.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(tmp)
-        raise
+    with atomic_path(path) as tmp:
+        tmp.write_text(text)
     return path

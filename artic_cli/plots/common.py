@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 
 import matplotlib
@@ -13,6 +11,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from ..geometry.wall import PARTS, WallSurface  # noqa: E402
+from ..io.store import atomic_path  # noqa: E402
 
 WALL_STYLE = {"palate": "#444444", "pharynx": "#444444", "mandible": "#8a6d3b"}
 
@@ -20,16 +19,11 @@ WALL_STYLE = {"palate": "#444444", "pharynx": "#444444", "mandible": "#8a6d3b"}
 def save_figure(fig, path: Path | str, dpi: int = 130) -> Path:
     """Write a PNG atomically and close the figure."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".png", dir=path.parent)
-    os.close(fd)
     try:
-        fig.savefig(tmp, dpi=dpi, bbox_inches="tight")
-        os.replace(tmp, path)
+        with atomic_path(path, ".png") as tmp:
+            fig.savefig(tmp, dpi=dpi, bbox_inches="tight", format="png")
     finally:
         plt.close(fig)
-        if os.path.exists(tmp):
-            os.unlink(tmp)
     return path
 
 
