@@ -50,6 +50,17 @@ def test_rest_posture_is_an_upright_equilibrium_inside_the_wall(art, rest):
     assert len(inverted_bricks(rest.x, art.bricks)) == 0
     _, _, gap, _ = wall_query(art.contact, rest.x)
     assert gap.max() <= art.contact.tolerance
+    # the closers' postural tone holds the mandible near its reference height against gravity
+    jaw = art.node_sets["jaw"][0]
+    assert abs(rest.x[jaw, 1] - art.rest[jaw, 1]) < 0.05
+
+
+def test_without_tone_gravity_drops_the_jaw(cfg, mesh, wall):
+    limp = build_articulator(cfg.model_copy(update={"muscles": cfg.muscles.model_copy(
+        update={"postural_tone_n": {}})}), mesh, wall)
+    rest = settle(limp)
+    jaw = limp.node_sets["jaw"][0]
+    assert rest.x[jaw, 1] - limp.rest[jaw, 1] < -0.3
 
 
 def test_a_strong_muscle_keeps_volume_and_stays_inside_the_wall(art, rest):

@@ -89,9 +89,10 @@ def test_simulate_drives_muscles_of_the_whole_articulator(mesh_file, tmp_path):
     sched = tmp_path / "sg.yaml"
     sched.write_text("duration_ms: 30\nmuscles:\n  - {muscle: SG, force_n: 4, onset_ms: 0, duration_ms: 30}\n"
                      "  - {muscle: JO, force_n: 3, onset_ms: 0, duration_ms: 30}\n")
-    out = tmp_path / "sg.h5"
-    res = artic("simulate", "--schedule", sched, "--mesh", mesh_file, "--out", out)
+    out, gif = tmp_path / "sg.h5", tmp_path / "sg.gif"
+    res = artic("simulate", "--schedule", sched, "--mesh", mesh_file, "--out", out, "--animate", gif)
     assert res.returncode == 0, res.stderr
+    assert gif.read_bytes()[:6] == b"GIF89a" and gif.stat().st_size > 10_000
     with h5py.File(out) as f:
         names = list(f["muscles"].attrs["names"])
         force = f["muscles/force"][()][:, names.index("SG")]
