@@ -131,6 +131,7 @@ class Jaw(_Strict):
     guide_stiffness_n_per_cm: Positive = 1000.0
     fossa_stop: bool = True           # the condyle cannot slide back beyond its rest seat in the glenoid fossa
     passive_stiffness_n_per_cm: NonNeg = 0.5
+    passive_relaxation_ms: NonNeg = 100.0  # jaw units' and straps' dashpots: this time x their spring
     strap_stiffness_n_per_cm: NonNeg = 10.0
     floor_link_area_cm2: Positive = 0.3
 

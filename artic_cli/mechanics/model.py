@@ -272,7 +272,7 @@ def _links(body: Body, cfg: Config, tissue_scale: float) -> tuple[CylinderSet, n
     area[floor] = jaw.floor_link_area_cm2
     e[floor] = tissue_scale * units.kpa_to_cgs(tissue.youngs_modulus_kpa)
     eta[floor] = tissue_scale * units.kpa_to_cgs(tissue.viscosity_kpa_s)
-    relax = units.kpa_to_cgs(tissue.viscosity_kpa_s) / units.kpa_to_cgs(tissue.youngs_modulus_kpa)  # 0.1 s
+    relax = units.ms_to_s(jaw.passive_relaxation_ms)  # dashpot = relaxation time x spring
     for mask, k_n_cm in ((kinds == LINK_KINDS.index("strap"), jaw.strap_stiffness_n_per_cm),
                          (kinds == -1, jaw.passive_stiffness_n_per_cm)):
         k = units.newton_to_dyn(k_n_cm)  # dyn/cm
