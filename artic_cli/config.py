@@ -142,6 +142,49 @@ class Contact(_Strict):
     tolerance_cm: Positive = 0.01
 
 
+Pair = Annotated[list[str], Field(min_length=2, max_length=2)]
+
+
+class Group(_Strict):
+    independent: str  # its force is the co-contraction level
+    pair: Pair  # the agonist/antagonist pair
+
+
+JAW_POSITIONS = {"rest": {}, "JO_0.5": {"JO": 0.5}, "JO_1.2": {"JO": 1.2}, "JO_2.5": {"JO": 2.5}, "JO_4": {"JO": 4.0},
+                 "JO_6": {"JO": 6.0}, "JC_0.5": {"JC": 0.5}, "JC_1.5": {"JC": 1.5}, "JC_3": {"JC": 3.0}}
+
+
+class EPMapSpec(_Strict):
+    """What ``artic ep-map`` computes (the paper's section IV.B)."""
+
+    duration_ms: Positive = 300.0  # each equilibrium: the muscle force held this long from the jaw position's rest
+    convergence_window_ms: Positive = 50.0
+    convergence_tol_cm: Positive = 0.01  # converged: control points moved less than this over the last window
+    early_stop_tol_cm: Positive = 0.002  # --fast: stop once they move less than this over a window
+    jaw_positions: dict[str, dict[str, NonNeg]] = JAW_POSITIONS  # name -> jaw forces held (N)
+    typical_jaw: str = "JO_0.5"
+    levels_n: list[NonNeg] = [0.0, 0.1, 0.2, 0.4, 1.0, 2.5, 4.0, 6.0]
+    muscles: list[str] = ["GGa", "GGm", "GGp", "HG", "SG", "SL", "IL", "V", "T", "MH", "GH", "T-SL"]
+    pair_levels_n: list[Positive] = [0.5, 1.0, 2.0, 4.0]  # contour lines of a two-muscle net (plus 0)
+    pairs_tip: list[Pair] = [["SL", "GGa"], ["SL", "IL"], ["SL", "GGp"], ["SL", "SG"], ["SL", "HG"],
+                             ["T-SL", "GGa"], ["T-SL", "SL"], ["T-SL", "GGp"], ["GGp", "SG"], ["GGp", "HG"],
+                             ["GGp", "IL"], ["GGa", "IL"], ["GGa", "SG"], ["GGm", "SG"], ["GGm", "HG"],
+                             ["V", "SL"], ["HG", "SG"]]
+    pairs_dorsum: list[Pair] = [["SG", "HG"], ["GGp", "HG"], ["GGm", "SG"], ["GGp", "SG"], ["MH", "SG"]]
+    groups: list[Group] = [Group(independent="SG", pair=["GGp", "SL"]), Group(independent="GGp", pair=["GGa", "IL"]),
+                           Group(independent="GGm", pair=["SL", "T-SL"]), Group(independent="T-SL", pair=["GGm", "HG"]),
+                           Group(independent="HG", pair=["GGp", "SL"])]
+    group_levels_n: list[Positive] = [0.1, 0.2, 0.5, 1.0]  # co-contraction levels of the independent muscle (plus 0)
+    net_jaw_positions: list[str] = ["JO_0.5"]  # where the two- and three-muscle nets are built
+
+    @field_validator("levels_n", "pair_levels_n", "group_levels_n")
+    @classmethod
+    def _increasing(cls, v):
+        if any(b <= a for a, b in zip(v, v[1:])):
+            raise ValueError("force levels must increase")
+        return v
+
+
 class Cuboid(_Strict):
     size_cm: Point3 = [6.0, 3.0, 2.0]
     bricks: Annotated[list[int], Field(min_length=3, max_length=3)] = [5, 3, 2]
@@ -157,6 +200,7 @@ class Config(_Strict):
     jaw: Jaw = Jaw()
     contact: Contact = Contact()
     cuboid: Cuboid = Cuboid()
+    epmap: EPMapSpec = EPMapSpec()
 
 
 
@@ -224,6 +268,11 @@ def _digest(data) -> str:
 def config_hash(cfg: Config) -> str:
     """Stable content hash (sha256 of canonical JSON) of a validated config."""
     return _digest(cfg.model_dump(mode="json"))
+
+
+def model_hash(cfg: Config) -> str:
+    """Hash of what a simulation depends on: everything but the experiment and map specifications."""
+    return _digest(cfg.model_dump(mode="json", exclude={"cuboid", "epmap"}))
 
 
 def geometry_hash(cfg: Config) -> str:

@@ -45,10 +45,26 @@ def handle_errors(fn):
     return wrapper
 
 
-def _progress(label: str):
-    """A rich progress bar (done/total, ETA) when stderr is a terminal, else None."""
+def _progress(label: str, plain: bool = False):
+    """A rich progress bar (done/total, ETA) when stderr is a terminal, else None; with ``plain``, lines at
+    every tenth of the work instead (for logs)."""
     if not sys.stderr.isatty():
-        return None, None
+        if not plain:
+            return None, None
+        import time
+
+        start, last = time.perf_counter(), [-1]
+
+        def log(done: int, total: int) -> None:
+            tenth = 10 * done // max(total, 1)
+            if tenth != last[0] and done:
+                last[0] = tenth
+                el = time.perf_counter() - start
+                eta = el / done * (total - done)
+                err_console.print(f"{label}: {done}/{total} ({100 * done // total} %), elapsed {el:.0f} s, "
+                                  f"eta {eta:.0f} s", highlight=False)
+
+        return None, log
     bar = Progress(TextColumn(label), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
                    TextColumn("eta"), TimeRemainingColumn(), console=err_console, transient=True)
     task = bar.add_task(label, total=None)
@@ -184,6 +200,86 @@ def experiment_cmd(
         table.add_row(r.name, "n/a" if r.ours is None else f"{r.ours:.3g}", "" if r.paper is None else f"{r.paper:g}",
                       r.unit, r.note)
     out_console.print(table)
+
+
+@app.command("ep-map")
+@handle_errors
+def ep_map_cmd(
+    mesh: Path = typer.Option(Path("data/mesh.h5"), "--mesh", help="Mesh artefact from build-mesh."),
+    config: Optional[Path] = typer.Option(None, "--config", help="Config the mesh was built from (its 'epmap' "
+                                                                 "section says what to compute)."),
+    out: Path = typer.Option(Path("data/epmaps.h5"), "--out", help="EP maps to write (HDF5)."),
+    jobs: int = typer.Option(2, "--jobs", help="Parallel workers (processes)."),
+    backend: str = typer.Option("loky", "--backend", help="loky (this machine) or dask (a dask.distributed "
+                                                          "cluster; a local one over loopback without --scheduler)."),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Address of a dask scheduler, "
+                                                                     "e.g. tcp://10.0.0.5:8786."),
+    fast: bool = typer.Option(False, "--fast", help="Stop each equilibrium once it has settled instead of "
+                                                    "holding the full duration (agrees within 0.02 cm)."),
+    cache: Optional[Path] = typer.Option(None, "--cache", help="Where finished EPs are kept for resuming "
+                                                               "(default: <out folder>/cache)."),
+    force: bool = typer.Option(False, "--force", help="Rewrite the map file even if it is up to date."),
+):
+    """Equilibrium-position maps at every jaw position (the paper's section IV.B), in parallel, resumable."""
+    from ..control.epmap import build_ep_maps
+    from ..experiments.paper import PAPER_CONTRIBUTION
+
+    bar, update = _progress("equilibria", plain=True)
+    try:
+        if bar is not None:
+            with bar:
+                r = build_ep_maps(mesh, config, out, jobs, backend, scheduler, fast, cache, update, force)
+        else:
+            r = build_ep_maps(mesh, config, out, jobs, backend, scheduler, fast, cache, update, force)
+    except KeyboardInterrupt:
+        err_console.print(f"interrupted; {out} was not touched, finished equilibria are cached and a rerun "
+                          "resumes from them")
+        raise typer.Exit(130) from None
+    if r.up_to_date:
+        out_console.print(f"{r.path} is up to date (same mesh, config and map spec); nothing to do "
+                          "(--force rewrites it)", highlight=False)
+        return
+    out_console.print(f"wrote {r.path}: {r.total} equilibria ({r.computed} computed, {r.cached} from the cache) "
+                      f"in {r.wall_time_s:.1f} s with {jobs} {backend} worker(s)", highlight=False)
+    if r.unconverged:
+        out_console.print(f"[yellow]not settled (flagged 'converged = false' in the file, never used silently):[/] "
+                          + "; ".join(r.unconverged), highlight=False)
+    else:
+        out_console.print("every equilibrium settled (control points moved < tolerance over the last window)")
+    if r.not_monotonic:
+        out_console.print("[yellow]EP vectors not monotonic:[/] " + "; ".join(r.not_monotonic), highlight=False)
+    c = r.contribution
+    table = Table(title=f"Contribution factors (Table III), jaw position '{c['jaw']}'")
+    for col in ("muscle", "tip", "paper tip", "dorsum", "paper dorsum", "tip amplitude cm", "dorsum amplitude cm"):
+        table.add_column(col, justify="left" if col == "muscle" else "right")
+    for m, (ft, fd) in c["factor"].items():
+        pt, pd = PAPER_CONTRIBUTION.get(m, (None, None))
+        at, ad = c["amplitude_cm"][m]
+        table.add_row(m, f"{ft:.2f}", "" if pt is None else f"{pt:.2f}", f"{fd:.2f}", "" if pd is None else f"{pd:.2f}",
+                      f"{at:.3f}", f"{ad:.3f}")
+    out_console.print(table)
+
+
+plot_app = typer.Typer(no_args_is_help=True, help="Pictures of the artefacts.")
+app.add_typer(plot_app, name="plot", help="Pictures of the artefacts (EP maps, ...).")
+
+
+@plot_app.command("ep-map")
+@handle_errors
+def plot_ep_map_cmd(
+    maps: Path = typer.Option(Path("data/epmaps.h5"), "--maps", help="EP maps from 'artic ep-map'."),
+    jaw: Optional[str] = typer.Option(None, "--jaw", help="Jaw position (default: the typical one, JO_0.5)."),
+    pair: Optional[str] = typer.Option(None, "--pair", help="Two-muscle net to draw, e.g. SG+HG (default: the "
+                                                            "first stored at that jaw position)."),
+    out: Path = typer.Option(Path("reports/epmap.png"), "--out", help="Picture to write (PNG)."),
+):
+    """Fig. 8: EP vectors of the tip and dorsum, with one two-muscle contour net."""
+    from ..control.epmap import load_ep_maps
+    from ..plots.epmap import plot_ep_map
+
+    m = load_ep_maps(maps)
+    path = plot_ep_map(m, jaw, pair, out)
+    out_console.print(f"wrote {path}", highlight=False)
 
 
 @app.command("report")

@@ -18,6 +18,10 @@ from ..mechanics.simulate import run, settle
 
 PAPER_JAW_EP = {"JO": ((0.5, -0.16), (1.2, -0.37), (2.5, -0.76), (4.0, -1.10), (6.0, -1.42)),
                 "JC": ((0.5, 0.09), (1.5, 0.21), (3.0, 0.47))}
+# Table III: contribution factors (tip, dorsum)
+PAPER_CONTRIBUTION = {"GGa": (0.37, 0.39), "GGm": (0.58, 0.72), "GGp": (0.68, 0.74), "HG": (0.74, 0.86),
+                      "SG": (0.94, 1.0), "SL": (1.0, 0.45), "IL": (0.69, 0.13), "V": (0.36, 0.43), "T": (0.31, 0.22),
+                      "T-SL": (0.65, 0.17), "MH": (0.21, 0.36)}
 PAPER_FIG4_SG = {"tip": 41.0, "dorsum": 30.0, "jaw": 8.0}  # Table II, cm/s
 # Section IV.A.1: definite directions (unit vectors in x, y) of the tip and dorsum for each muscle
 _D = {"up": (0, 1), "down": (0, -1), "back": (-1, 0), "front": (1, 0)}

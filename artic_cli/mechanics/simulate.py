@@ -153,3 +153,36 @@ def settle(model: Model, max_time: float = 5.0) -> State:
     """The rest posture: equilibrium under gravity with every muscle at zero force (t = 0)."""
     state, _ = equilibrate(model, rest_state(model), zero_control(model), dt=0.01, tol=1e-2, max_time=max_time)
     return State(t=0.0, x=state.x, v=np.zeros_like(state.v), sigma2=state.sigma2, fibre_strain=state.fibre_strain)
+
+
+@dataclass
+class Hold:
+    """The end of holding a constant control: the state, how far the watched nodes moved over the last
+    window (cm) and when it stopped (s after the start)."""
+
+    state: State
+    drift: float
+    stopped: float
+
+
+@single_threaded
+def hold(model: Model, state: State, control: Control, duration: float, watch: np.ndarray, window: float,
+         stop_below: float | None = None, dt: float | None = None) -> Hold:
+    """Step under a constant ``control`` for ``duration`` s, or (``stop_below``) until the ``watch`` nodes
+    have moved less than ``stop_below`` cm over the last ``window`` s."""
+    h = float(model.options.dt if dt is None else dt)
+    n_steps = max(1, int(round(duration / h)))
+    lag = max(1, int(round(window / h)))
+    t0 = state.t
+    past = [state.x[watch].copy()]
+    drift = np.inf
+    for k in range(1, n_steps + 1):
+        state = step(model, state, control, h)
+        past.append(state.x[watch].copy())
+        if len(past) > lag + 1:
+            past.pop(0)
+        if k >= lag:
+            drift = float(np.linalg.norm(past[-1] - past[0], axis=1).max())
+            if stop_below is not None and drift < stop_below:
+                break
+    return Hold(state=state, drift=drift, stopped=state.t - t0)

@@ -1,0 +1,1 @@
+"""Control: EP maps, dynamic maps and the target solver."""
