@@ -37,6 +37,14 @@ def model(cfg, mesh):
 
 
 @pytest.fixture(scope="session")
+def art(cfg, mesh, wall):
+    """The whole articulator (tongue, jaw, hyoid, muscles, contact)."""
+    from artic_cli.mechanics.model import build_articulator
+
+    return build_articulator(cfg, mesh, wall)
+
+
+@pytest.fixture(scope="session")
 def mesh_file(tmp_path_factory):
     out = tmp_path_factory.mktemp("mesh") / "mesh.h5"
     build_mesh(ROOT / "configs" / "default.yaml", out)

@@ -14,11 +14,6 @@ from artic_cli.schedule import parse_schedule
 
 
 @pytest.fixture(scope="module")
-def art(cfg, mesh, wall):
-    return build_articulator(cfg, mesh, wall)
-
-
-@pytest.fixture(scope="module")
 def rest(art):
     return settle(art)
 

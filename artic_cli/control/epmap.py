@@ -261,9 +261,12 @@ class BuildResult:
     not_monotonic: list[str] = field(default_factory=list)
 
 
+MAP_FORMAT = 2  # bump when the file layout changes: an old file is then rebuilt (from the cache)
+
+
 def inputs_hash(cfg: Config, mesh_sha: str, fast: bool) -> str:
     blob = json.dumps({"model": model_hash(cfg), "mesh": mesh_sha, "spec": cfg.epmap.model_dump(mode="json"),
-                       "fast": fast, "version": __version__}, sort_keys=True)
+                       "fast": fast, "version": __version__, "format": MAP_FORMAT}, sort_keys=True)
     return hashlib.sha256(blob.encode()).hexdigest()
 
 
@@ -449,9 +452,12 @@ def write_ep_maps(path: Path, maps: EPMaps, cfg: Config, mesh_sha: str, inputs: 
                         "units": "positions in cm (x anterior, y superior, z left), forces in N",
                         "layout": "jaw_positions/<jaw>/{rest, single/<muscle>, pair/<a+b>, group/<i+a+b>}: "
                                   "force_<k>_n per axis; tip, dorsum, jaw (*grid, 3) in cm; converged; drift_cm"})
+        f.attrs["jaw_order"] = list(maps.jaws)
         for jname, jm in maps.jaws.items():
             g = f.create_group(f"jaw_positions/{jname}")
             g.attrs["jaw_forces_n"] = json.dumps(jm.forces)
+            for fam in ("single", "pair", "group"):
+                g.attrs[f"{fam}_order"] = list(getattr(jm, fam))
             r = g.create_group("rest")
             for c, cp in enumerate(CONTROL_POINTS):
                 r.create_dataset(cp, data=jm.rest[c]).attrs["units"] = "cm"
@@ -479,11 +485,13 @@ def load_ep_maps(path: Path | str = "data/epmaps.h5", mesh: Path | str | None = 
             if mesh is not None and f.attrs["mesh_sha256"] != file_hash(mesh):
                 raise ArticError(f"{path} was built from another mesh than {mesh}; {hint}")
             jaws = {}
-            for jname, g in f["jaw_positions"].items():
+            for jname in f.attrs["jaw_order"]:
+                g = f["jaw_positions"][jname]
                 rest = np.array([g["rest"][cp][()] for cp in CONTROL_POINTS])
                 jm = JawMaps(forces=json.loads(g.attrs["jaw_forces_n"]), rest=rest, single={})
                 for fam in ("single", "pair", "group"):
-                    for name, n in g.get(fam, {}).items():
+                    for name in g.attrs[f"{fam}_order"]:
+                        n = g[fam][name]
                         muscles = tuple(n.attrs["muscles"])
                         levels = tuple(n[f"force_{k}_n"][()] for k in range(len(muscles)))
                         x = np.stack([n[cp][()] for cp in CONTROL_POINTS], axis=-2)

@@ -169,9 +169,30 @@ def stress(model: Model, force: float = 7.0, duration: float = 0.5) -> list[Row]
 
 
 STRESS_MUSCLES = ("GGp", "SG", "HG", "SL", "IL")
+FIG7_STARTS = (("SL", "GGa"), ("SG", "HG"), ("GGp", "GGm"), ("IL", "V"))  # four starting shapes, 5 N each
+
+
+def fig7(model: Model, muscles=("GGp", "SG"), forces=(1.0, 2.0, 3.5, 5.0), duration: float = 0.4) -> list[Row]:
+    """Fig. 7: one muscle from four different starting shapes reaches one EP per force level."""
+    rest = settle(model)
+    pts = _points(model)
+    audit = Audit(model)
+    starts = [audit.run(rest, {m: 5.0 for m in combo}, 0.3)[1] for combo in FIG7_STARTS]
+    rows = []
+    for muscle in muscles:
+        for force in forces:
+            ends = np.array([audit.run(s, {muscle: force}, duration)[1].x for s in starts])
+            for cp in ("tip", "dorsum"):
+                p = ends[:, pts[cp]]
+                spread = max(float(np.linalg.norm(a - b)) for a in p for b in p)
+                moved = min(float(np.linalg.norm(p[k] - s.x[pts[cp]])) for k, s in enumerate(starts))
+                rows.append(Row(f"{muscle} {force:g} N {cp}: spread of the four end points", spread, None, "cm",
+                                f"starts {' / '.join('+'.join(c) for c in FIG7_STARTS)} at 5 N; "
+                                f"each moved at least {moved:.2f} cm"))
+    return rows + audit.rows()
 
 EXPERIMENTS = {"jaw-ep": jaw_ep, "fig4": fig4, "muscle-directions": muscle_directions, "k-closure": k_closure,
-               "stress": stress}
+               "stress": stress, "fig7": fig7}
 
 
 def rows_as_dicts(rows: list[Row]) -> list[dict]:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import matplotlib.pyplot as plt
@@ -16,15 +17,21 @@ def plot_ep_map(maps, jaw: str | None, pair: str | None, path: Path | str) -> Pa
     if jaw not in maps.jaws:
         raise ArticError(f"no jaw position '{jaw}' in the maps; stored: {', '.join(maps.jaws)}")
     jm = maps.jaws[jaw]
-    if pair is None and jm.pair:
-        pair = next(iter(jm.pair))
-    if pair is not None and pair not in jm.pair:
-        swapped = "+".join(reversed(pair.split("+")))
-        if swapped in jm.pair:
-            pair = swapped
-        else:
-            stored = ", ".join(jm.pair) or "none (nets are built at " + maps.typical_jaw + ")"
-            raise ArticError(f"no two-muscle net '{pair}' at jaw position '{jaw}'; stored: {stored}")
+
+    def find(name: str) -> str:
+        for cand in (name, "+".join(reversed(name.split("+")))):
+            if cand in jm.pair:
+                return cand
+        stored = ", ".join(jm.pair) or "none (nets are built at " + maps.typical_jaw + ")"
+        raise ArticError(f"no two-muscle net '{name}' at jaw position '{jaw}'; stored: {stored}")
+
+    if pair is not None:
+        nets = [find(pair)] * 2
+    else:  # the first net of the tip list on the tip panel, of the dorsum list on the dorsum panel (Fig. 8)
+        spec = json.loads(maps.attrs.get("spec_yaml", "{}"))
+        firsts = [spec.get("pairs_tip") or [], spec.get("pairs_dorsum") or []]
+        nets = [find("+".join(f[0])) if f and jm.pair else (next(iter(jm.pair)) if jm.pair else None)
+                for f in firsts]
     fig, axes = plt.subplots(1, 2, figsize=(13, 6))
     colours = plt.cm.tab20(np.linspace(0, 1, max(len(jm.single), 2)))
     for c, (ax, cp) in enumerate(zip(axes, ("tip", "dorsum"))):
@@ -36,6 +43,7 @@ def plot_ep_map(maps, jaw: str | None, pair: str | None, path: Path | str) -> Pa
             bad = ~net.converged
             if bad.any():
                 ax.plot(xy[bad, 0], xy[bad, 1], "o", mfc="none", mec="red", ms=9)
+        pair = nets[c]
         if pair is not None:
             net = jm.pair[pair]
             g = net.x[:, :, c, :2]
@@ -44,7 +52,8 @@ def plot_ep_map(maps, jaw: str | None, pair: str | None, path: Path | str) -> Pa
             for j in range(g.shape[1]):
                 ax.plot(g[:, j, 0], g[:, j, 1], "--", color="0.35", lw=0.7)
             a, b = net.muscles
-            ax.plot([], [], "-", color="0.35", lw=0.7, label=f"net {a}+{b}: {b} varies (solid), {a} varies (dashed)")
+            ax.text(0.02, 0.02, f"contour net {a}+{b}: {b} varies along solid lines, {a} along dashed ones",
+                    transform=ax.transAxes, fontsize=7, color="0.25")
         ax.set_aspect("equal")
         ax.set_title(f"{cp} EPs, jaw position {jaw} (levels {', '.join(f'{v:g}' for v in next(iter(jm.single.values())).levels[0])} N)",
                      fontsize=9)
