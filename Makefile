@@ -71,6 +71,7 @@ test: setup
 bench: setup
 	$(PY) benchmarks/bench_tissue.py
 	$(PY) benchmarks/bench_articulator.py
+	$(PY) benchmarks/bench_epmap.py
 
 clean:
 	rm -rf $(OUT)/*.h5 $(OUT)/*.json $(SIMS) $(OUT)/experiments $(REPORT)/*.png $(REPORT)/*.gif $(REPORT)/paper.md
