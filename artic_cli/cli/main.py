@@ -260,6 +260,102 @@ def ep_map_cmd(
     out_console.print(table)
 
 
+@app.command("dynamic-map")
+@handle_errors
+def dynamic_map_cmd(
+    maps: Path = typer.Option(Path("data/epmaps.h5"), "--maps", help="EP maps from 'artic ep-map'."),
+    out: Path = typer.Option(Path("data/dynamic.h5"), "--out", help="Dynamic map to write (HDF5)."),
+    as_json: bool = typer.Option(False, "--json", help="Print Table IV as JSON."),
+):
+    """Derive the map of any jaw position from the typical one (rotation + translation); Table IV."""
+    from ..control.dynamic import build_dynamic_map, table_iv
+
+    dm = build_dynamic_map(maps, out)
+    rows = table_iv(dm)
+    if as_json:
+        out_console.print_json(json.dumps(rows))
+        return
+    table = Table(title=f"Table IV: derived ({dm.typical} carried by the fitted transform) vs simulated EP maps")
+    for col in ("jaw", "position cm", "paper", "jaw rot. deg", "map rot. tip/dorsum deg", "tip error cm", "paper",
+                "dorsum error cm", "paper", "leave-one-out tip/dorsum cm"):
+        table.add_column(col, justify="left" if col == "jaw" else "right")
+    f = lambda v, p=3: "" if v is None else f"{v:.{p}f}"  # noqa: E731
+    for r in rows:
+        table.add_row(r["jaw"], f"{r['position_cm']:+.3f}", f(r["paper_position_cm"]), f"{r['jaw_angle_deg']:+.2f}",
+                      f"{r['theta_deg'][0]:+.2f} / {r['theta_deg'][1]:+.2f}", f(r["error_tip_cm"]),
+                      f(r["paper_tip_cm"]), f(r["error_dorsum_cm"]), f(r["paper_dorsum_cm"]),
+                      "" if r["loo_tip_cm"] is None else f"{r['loo_tip_cm']:.3f} / {r['loo_dorsum_cm']:.3f}")
+    out_console.print(table)
+    out_console.print(f"wrote {out}", highlight=False)
+
+
+@app.command("solve-target")
+@handle_errors
+def solve_target_cmd(
+    target: Optional[Path] = typer.Argument(None, help="Target file (YAML): jaw, crucial and indecisive features."),
+    maps: Path = typer.Option(Path("data/epmaps.h5"), "--maps", help="EP maps from 'artic ep-map'."),
+    dynamic: Path = typer.Option(Path("data/dynamic.h5"), "--dynamic", help="Dynamic map from 'artic dynamic-map'."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Result (YAML; CSV with --batch); default "
+                                                           "data/solutions/<name>.yaml or .csv."),
+    verify: bool = typer.Option(False, "--verify", help="Simulate the force set and report the error."),
+    refine: bool = typer.Option(False, "--refine", help="Correct the force set by a few simulations until the "
+                                                        "crucial feature is within its tolerance."),
+    budget: int = typer.Option(8, "--budget", help="Most simulations --refine may spend."),
+    batch: Optional[Path] = typer.Option(None, "--batch", help="Solve every row of this CSV instead."),
+    jobs: int = typer.Option(2, "--jobs", help="Parallel workers for --batch with --verify/--refine."),
+    mesh: Path = typer.Option(Path("data/mesh.h5"), "--mesh", help="Mesh for --verify / --refine."),
+    config: Optional[Path] = typer.Option(None, "--config", help="Config for --verify / --refine."),
+):
+    """Muscle forces that put the crucial feature on its target and approach the others (section V)."""
+    from ..control.targets import batch_csv, load_context, load_target, read_batch, solve, solve_batch, write_solution
+    from ..io.store import write_text_atomic
+
+    if (target is None) == (batch is None):
+        raise ArticError("give a target file or --batch CSV (one of them)")
+    if budget < 1:
+        raise ArticError(f"--budget must be at least 1, got {budget}")
+    ctx = load_context(maps, dynamic, mesh if (verify or refine) else None)
+    if batch is not None:
+        targets = read_batch(batch)
+        bar, update = _progress("targets", plain=True)
+        args = (str(mesh), None if config is None else str(config))
+        if bar is not None:
+            with bar:
+                res = solve_batch(ctx, targets, jobs, args, verify, refine, budget, update)
+        else:
+            res = solve_batch(ctx, targets, jobs, args, verify, refine, budget, update)
+        path = out or Path("data/solutions") / f"{batch.stem}.csv"
+        write_text_atomic(path, batch_csv(res))
+        bad = sum("unreachable" in r for r in res)
+        out_console.print(f"wrote {path}: {len(res)} targets, {len(res) - bad} solved, {bad} unreachable",
+                          highlight=False)
+        return
+    t = load_target(target)
+    sim = None
+    if verify or refine:
+        from ..control.verify import Simulator
+
+        sim = Simulator(mesh, config)
+    doc = solve(ctx, t, sim, verify, refine, budget)
+    path = out or Path("data/solutions") / f"{t.name}.yaml"
+    write_solution(path, doc)
+    ch = doc["chosen"]
+    forces = ", ".join(f"{k} {v:g} N" for k, v in ch["forces_n"].items())
+    out_console.print(f"{t.name}: {ch['family']} {ch['map']}: {forces}; predicted tip {ch['predicted_cm']['tip']}, "
+                      f"dorsum {ch['predicted_cm']['dorsum']} cm; cost {ch['cost']:.3f} "
+                      f"(best of {doc['candidates_considered']} candidates)", highlight=False)
+    if "verified" in doc:
+        out_console.print(f"verified by simulation: crucial error {doc['verified']['crucial_error_cm']:.3f} cm",
+                          highlight=False)
+    if "refined" in doc:
+        r = doc["refined"]
+        forces = ", ".join(f"{k} {v:g} N" for k, v in r["forces_n"].items())
+        out_console.print(f"refined: {forces}; crucial error {r['crucial_error_cm']:.3f} cm after "
+                          f"{r['simulations']} simulations" + ("" if r["converged"] else " (tolerance not reached)"),
+                          highlight=False)
+    out_console.print(f"wrote {path}", highlight=False)
+
+
 plot_app = typer.Typer(no_args_is_help=True, help="Pictures of the artefacts.")
 app.add_typer(plot_app, name="plot", help="Pictures of the artefacts (EP maps, ...).")
 
@@ -279,6 +375,30 @@ def plot_ep_map_cmd(
 
     m = load_ep_maps(maps)
     path = plot_ep_map(m, jaw, pair, out)
+    out_console.print(f"wrote {path}", highlight=False)
+
+
+@plot_app.command("solution")
+@handle_errors
+def plot_solution_cmd(
+    solution: Path = typer.Argument(..., help="Result of 'artic solve-target' (YAML)."),
+    target: Path = typer.Option(..., "--target", help="The target file it solved."),
+    maps: Path = typer.Option(Path("data/epmaps.h5"), "--maps", help="EP maps."),
+    dynamic: Path = typer.Option(Path("data/dynamic.h5"), "--dynamic", help="Dynamic map."),
+    out: Path = typer.Option(Path("reports/solution.png"), "--out", help="Picture to write (PNG)."),
+):
+    """Fig. 12: targets, the candidate force sets' predicted positions and the chosen one."""
+    from ..config import read_yaml
+    from ..control.targets import jaw_maps, load_context, load_target
+    from ..plots.solution import plot_solution
+
+    doc = read_yaml(solution, "solution file")
+    if not isinstance(doc, dict) or "chosen" not in doc:
+        raise ArticError(f"{solution} is not a solve-target result; run 'artic solve-target' first")
+    t = load_target(target)
+    ctx = load_context(maps, dynamic)
+    jm, _, _, _ = jaw_maps(ctx, t)
+    path = plot_solution(doc, t, jm, out)
     out_console.print(f"wrote {path}", highlight=False)
 
 

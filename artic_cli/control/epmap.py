@@ -200,7 +200,7 @@ def compute_ep(key: str, jaw_forces: Forces, forces: Forces, spec_json: str, fas
 def compute_rest(key: str, jaw_forces: Forces, cfg_json: str, mesh_path: str) -> dict:
     model = _model(key, cfg_json, mesh_path)
     st = _rest(key, jaw_forces, cfg_json, mesh_path)
-    return {"x": st.x[watch_nodes(model)].copy()}
+    return {"x": st.x[watch_nodes(model)].copy(), "mandible": st.x[model.node_sets["mandible"]].copy()}
 
 
 def _spec_key(spec: EPMapSpec) -> str:
@@ -261,7 +261,7 @@ class BuildResult:
     not_monotonic: list[str] = field(default_factory=list)
 
 
-MAP_FORMAT = 2  # bump when the file layout changes: an old file is then rebuilt (from the cache)
+MAP_FORMAT = 3  # bump when the file layout changes: an old file is then rebuilt (from the cache)
 
 
 def inputs_hash(cfg: Config, mesh_sha: str, fast: bool) -> str:
@@ -317,8 +317,9 @@ def build_ep_maps(mesh: Path | str = "data/mesh.h5", config: Path | str | None =
                     progress(done, len(calls))
     wall = time.perf_counter() - t0
     rests = {j: results[k]["x"] for k, j in enumerate(spec.jaw_positions)}
+    mandibles = {j: results[k]["mandible"] for k, j in enumerate(spec.jaw_positions)}
     eps = {(t.jaw, t.forces): results[len(spec.jaw_positions) + k] for k, t in enumerate(tasks)}
-    maps = assemble(spec, rests, eps)
+    maps = assemble(spec, rests, eps, mandibles)
     write_ep_maps(out, maps, cfg, mesh_sha, wanted, fast)
     return BuildResult(path=out, up_to_date=False, computed=len(calls) - cached, cached=cached, total=len(calls),
                        unconverged=maps.unconverged(), wall_time_s=wall,
@@ -362,6 +363,7 @@ class JawMaps:
     single: dict[str, Net]
     pair: dict[str, Net] = field(default_factory=dict)
     group: dict[str, Net] = field(default_factory=dict)
+    mandible: np.ndarray | None = None  # (K, 3) the mandible's nodes at this jaw position's rest, cm
 
 
 @dataclass
@@ -381,7 +383,8 @@ class EPMaps:
         return out
 
 
-def assemble(spec: EPMapSpec, rests: dict[str, np.ndarray], eps: dict) -> EPMaps:
+def assemble(spec: EPMapSpec, rests: dict[str, np.ndarray], eps: dict,
+             mandibles: dict[str, np.ndarray] | None = None) -> EPMaps:
     def get(jaw: str, forces: dict[str, float]):
         key = canonical(forces)
         if not key:
@@ -404,7 +407,8 @@ def assemble(spec: EPMapSpec, rests: dict[str, np.ndarray], eps: dict) -> EPMaps
     grid = [0.0, *spec.pair_levels_n]
     for jaw, jf in spec.jaw_positions.items():
         jm = JawMaps(forces=dict(jf), rest=rests[jaw],
-                     single={m: net(jaw, (m,), (spec.levels_n,)) for m in spec.muscles})
+                     single={m: net(jaw, (m,), (spec.levels_n,)) for m in spec.muscles},
+                     mandible=None if mandibles is None else mandibles[jaw])
         if jaw in spec.net_jaw_positions:
             for a, b in pairs(spec):
                 jm.pair[f"{a}+{b}"] = net(jaw, (a, b), (grid, grid))
@@ -461,6 +465,8 @@ def write_ep_maps(path: Path, maps: EPMaps, cfg: Config, mesh_sha: str, inputs: 
             r = g.create_group("rest")
             for c, cp in enumerate(CONTROL_POINTS):
                 r.create_dataset(cp, data=jm.rest[c]).attrs["units"] = "cm"
+            if jm.mandible is not None:
+                r.create_dataset("mandible", data=jm.mandible).attrs["units"] = "cm (the mandible's nodes)"
             for fam in ("single", "pair", "group"):
                 for name, net in getattr(jm, fam).items():
                     n = g.create_group(f"{fam}/{name}")
@@ -488,7 +494,8 @@ def load_ep_maps(path: Path | str = "data/epmaps.h5", mesh: Path | str | None = 
             for jname in f.attrs["jaw_order"]:
                 g = f["jaw_positions"][jname]
                 rest = np.array([g["rest"][cp][()] for cp in CONTROL_POINTS])
-                jm = JawMaps(forces=json.loads(g.attrs["jaw_forces_n"]), rest=rest, single={})
+                jm = JawMaps(forces=json.loads(g.attrs["jaw_forces_n"]), rest=rest, single={},
+                             mandible=g["rest"]["mandible"][()] if "mandible" in g["rest"] else None)
                 for fam in ("single", "pair", "group"):
                     for name in g.attrs[f"{fam}_order"]:
                         n = g[fam][name]

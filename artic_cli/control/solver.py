@@ -1,0 +1,276 @@
+"""From spatial targets to muscle force sets through the EP maps (the paper's section V, Fig. 12).
+
+A target names a jaw position, one *crucial* feature (a control point that
+must reach a place, within a tolerance) and *indecisive* features (places the
+other control points should approach, with weights).  The solver
+
+1. takes the EP maps at the jaw position (stored, or derived from the typical
+   map by the dynamic map);
+2. finds every force set that puts the crucial control point on its target:
+   along single-muscle EP vectors (within the tolerance), inside two-muscle
+   contour nets and inside each co-contraction level of the three-muscle
+   groups (bilinear interpolation in each net cell, inverted exactly);
+3. keeps those and picks the one with the least cost
+   ``force_weight * sum F^2 + distance_weight * sum w_i |p_i - target_i|^2``
+   over the indecisive features (the paper's choice of the co-contraction
+   level in Fig. 12).
+
+Only settled EPs are used: a net cell or vector segment with an unsettled
+corner is skipped.  With no candidate the target is unreachable: the error
+names the nearest reachable point and its distance.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Annotated, Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
+
+from ..errors import ArticError, UnreachableTarget
+from .epmap import CONTROL_POINTS, JawMaps, Net
+
+Point2 = Annotated[list[float], Field(min_length=2, max_length=2)]
+POINT = Literal["tip", "dorsum"]
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class JawSpec(_Strict):
+    forces_n: dict[Literal["JO", "JC"], Annotated[float, Field(ge=0, allow_inf_nan=False)]] | None = None
+    opening_cm: Annotated[float, Field(allow_inf_nan=False)] | None = None  # incisor height relative to rest
+
+
+class Crucial(_Strict):
+    point: POINT
+    at_cm: Point2
+    tolerance_cm: Annotated[float, Field(gt=0, allow_inf_nan=False)] = 0.05
+
+
+class Indecisive(_Strict):
+    point: POINT
+    at_cm: Point2
+    weight: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 1.0
+
+
+class TargetSpec(_Strict):
+    name: str = "target"
+    jaw: JawSpec = JawSpec(forces_n={"JO": 0.5})
+    crucial: Crucial
+    indecisive: list[Indecisive] = []
+    force_weight: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 1.0  # per N^2
+    distance_weight: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 100.0  # per cm^2
+
+
+def parse_target(data: object, source: str = "<target>") -> TargetSpec:
+    if not isinstance(data, dict):
+        raise ArticError(f"{source}: a target must be a YAML mapping with 'crucial' (and 'jaw', 'indecisive')")
+    try:
+        t = TargetSpec.model_validate(data)
+    except ValidationError as err:
+        first = err.errors()[0]
+        loc = ".".join(str(p) for p in first["loc"])
+        if first["type"] == "literal_error" and loc.endswith("point"):
+            raise ArticError(f"{source}: key '{loc}': no control point {first['input']!r}; valid: tip, dorsum") from None
+        if first["type"] == "extra_forbidden":
+            raise ArticError(f"{source}: unknown key '{loc}'; fix the key and rerun") from None
+        if first["type"] == "missing":
+            raise ArticError(f"{source}: missing key '{loc}'") from None
+        raise ArticError(f"{source}: key '{loc}': {first['msg']}") from None
+    if (t.jaw.forces_n is None) == (t.jaw.opening_cm is None):
+        raise ArticError(f"{source}: key 'jaw': give either forces_n (JO or JC, N) or opening_cm")
+    if t.jaw.forces_n is not None and t.jaw.forces_n.get("JO", 0) > 0 and t.jaw.forces_n.get("JC", 0) > 0:
+        raise ArticError(f"{source}: key 'jaw.forces_n': give JO or JC, not both")
+    points = [t.crucial.point] + [i.point for i in t.indecisive]
+    if len(set(points)) != len(points):
+        raise ArticError(f"{source}: key 'indecisive': each control point once (the crucial one is {t.crucial.point})")
+    return t
+
+
+@dataclass
+class Candidate:
+    family: str  # single, pair, group
+    name: str  # map name
+    forces: dict[str, float]  # N
+    predicted: dict[str, list[float]]  # control point -> (x, y) cm
+    crucial_error: float  # cm
+    cost: float
+    detail: dict = field(default_factory=dict)  # cell and local coordinates (for refinement)
+
+
+def _settled_run(net: Net) -> int:
+    """How many levels of a vector, from 0 N up, settled (a vector is used up to its first unsettled EP)."""
+    bad = np.flatnonzero(~net.converged)
+    return int(bad[0]) if len(bad) else len(net.converged)
+
+
+def _polyline_nearest(pts: np.ndarray, target: np.ndarray):
+    """Nearest point of a polyline (n, 2) to target: (distance, segment, fraction)."""
+    a, b = pts[:-1], pts[1:]
+    ab = b - a
+    t = np.clip(((target - a) * ab).sum(1) / np.maximum((ab * ab).sum(1), 1e-30), 0, 1)
+    d = np.linalg.norm(a + t[:, None] * ab - target, axis=1)
+    k = int(np.argmin(d))
+    return float(d[k]), k, float(t[k])
+
+
+def _bilinear(c: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """c: (..., 4, d) corners (00, 10, 01, 11); u, v: (...)."""
+    u, v = u[..., None], v[..., None]
+    return (1 - u) * (1 - v) * c[..., 0, :] + u * (1 - v) * c[..., 1, :] + (1 - u) * v * c[..., 2, :] + u * v * c[..., 3, :]
+
+
+def invert_cells(corners: np.ndarray, target: np.ndarray, iters: int = 12):
+    """Solve bilinear(u, v) = target in every cell (C, 4, 2) by Newton from the centre.
+
+    Returns u, v, residual (C,); a solution counts where u, v lie in [0, 1]."""
+    u = np.full(len(corners), 0.5)
+    v = np.full(len(corners), 0.5)
+    p00, p10, p01, p11 = (corners[:, k] for k in range(4))
+    for _ in range(iters):
+        r = _bilinear(corners, u, v) - target
+        du = (1 - v)[:, None] * (p10 - p00) + v[:, None] * (p11 - p01)
+        dv = (1 - u)[:, None] * (p01 - p00) + u[:, None] * (p11 - p10)
+        det = du[:, 0] * dv[:, 1] - du[:, 1] * dv[:, 0]
+        det = np.where(np.abs(det) < 1e-14, 1e-14, det)
+        u = u - (dv[:, 1] * r[:, 0] - dv[:, 0] * r[:, 1]) / det
+        v = v - (-du[:, 1] * r[:, 0] + du[:, 0] * r[:, 1]) / det
+        u, v = np.clip(u, -0.5, 1.5), np.clip(v, -0.5, 1.5)
+    res = np.linalg.norm(_bilinear(corners, u, v) - target, axis=1)
+    return u, v, res
+
+
+def _cells(net2: np.ndarray, conv: np.ndarray):
+    """Cells of a 2-D grid (na, nb, 3, 3) of EPs whose four corners settled: indices and corners (C, 4, 3, 2)."""
+    na, nb = conv.shape
+    ii, jj = np.meshgrid(np.arange(na - 1), np.arange(nb - 1), indexing="ij")
+    ii, jj = ii.ravel(), jj.ravel()
+    ok = conv[ii, jj] & conv[ii + 1, jj] & conv[ii, jj + 1] & conv[ii + 1, jj + 1]
+    ii, jj = ii[ok], jj[ok]
+    corners = np.stack([net2[ii, jj], net2[ii + 1, jj], net2[ii, jj + 1], net2[ii + 1, jj + 1]], axis=1)
+    return ii, jj, corners[..., :2, :2]  # tip and dorsum, x and y
+
+
+class Problem:
+    """A target on the maps of one jaw position."""
+
+    def __init__(self, jm: JawMaps, target: TargetSpec):
+        self.jm = jm
+        self.t = target
+        self.c = CONTROL_POINTS.index(target.crucial.point)
+        self.goal = np.asarray(target.crucial.at_cm, dtype=float)
+
+    def cost(self, forces: dict[str, float], pred: np.ndarray) -> float:
+        """pred: (2, 2) predicted tip and dorsum (x, y)."""
+        f = self.t.force_weight * sum(v * v for v in forces.values())
+        d = sum(i.weight * float(np.sum((pred[CONTROL_POINTS.index(i.point)] - np.asarray(i.at_cm)) ** 2))
+                for i in self.t.indecisive)
+        return float(f + self.t.distance_weight * d)
+
+    def _candidate(self, family, name, forces, pred, detail) -> Candidate:
+        forces = {k: float(v) for k, v in forces.items() if v > 1e-12}
+        err = float(np.linalg.norm(pred[self.c] - self.goal))
+        return Candidate(family=family, name=name, forces=forces,
+                         predicted={cp: [float(pred[k, 0]), float(pred[k, 1])] for k, cp in enumerate(("tip", "dorsum"))},
+                         crucial_error=err, cost=self.cost(forces, pred), detail=detail)
+
+    def singles(self) -> list[Candidate]:
+        out = []
+        for m, net in self.jm.single.items():
+            stop = _settled_run(net)
+            if stop < 2:
+                continue
+            pts = net.x[:stop, :2, :2]
+            d, k, frac = _polyline_nearest(pts[:, self.c], self.goal)
+            if d > self.t.crucial.tolerance_cm:
+                continue
+            lv = net.levels[0]
+            force = lv[k] + frac * (lv[k + 1] - lv[k])
+            pred = pts[k] + frac * (pts[k + 1] - pts[k])
+            out.append(self._candidate("single", m, {m: force}, pred, {"segment": k, "fraction": frac}))
+        return out
+
+    def _nets(self):
+        for name, net in self.jm.pair.items():
+            yield "pair", name, net.muscles, None, net.levels, net.x, net.converged
+        for name, net in self.jm.group.items():
+            for k in range(1, len(net.levels[0])):  # level 0 of a group is its pair net
+                yield ("group", name, net.muscles, (net.muscles[0], float(net.levels[0][k])),
+                       net.levels[1:], net.x[k], net.converged[k])
+
+    def nets(self) -> list[Candidate]:
+        out = []
+        for family, name, muscles, fixed, levels, x, conv in self._nets():
+            ii, jj, corners = _cells(x, conv)
+            if not len(ii):
+                continue
+            u, v, res = invert_cells(corners[:, :, self.c], self.goal)
+            inside = (u >= -1e-9) & (u <= 1 + 1e-9) & (v >= -1e-9) & (v <= 1 + 1e-9) & (res < 1e-6)
+            for k in np.flatnonzero(inside):
+                a, b = muscles[-2], muscles[-1]
+                la, lb = levels
+                fa = la[ii[k]] + u[k] * (la[ii[k] + 1] - la[ii[k]])
+                fb = lb[jj[k]] + v[k] * (lb[jj[k] + 1] - lb[jj[k]])
+                forces = {a: fa}
+                forces[b] = forces.get(b, 0.0) + fb
+                if fixed is not None:
+                    forces[fixed[0]] = forces.get(fixed[0], 0.0) + fixed[1]
+                pred = _bilinear(corners[k][None], np.array([u[k]]), np.array([v[k]]))[0]
+                label = name if fixed is None else f"{name} ({fixed[0]} {fixed[1]:g} N)"
+                out.append(self._candidate(family, label, forces, pred,
+                                           {"cell": [int(ii[k]), int(jj[k])], "uv": [float(u[k]), float(v[k])],
+                                            "net": name, "fixed": fixed}))
+        return out
+
+    def nearest_reachable(self) -> tuple[np.ndarray, float, str]:
+        """Closest point of the mapped region to the crucial target (vectors exactly, net cells sampled)."""
+        best = (None, np.inf, "")
+        for m, net in self.jm.single.items():
+            pts = net.x[: _settled_run(net), self.c, :2]
+            if len(pts) < 2:
+                continue
+            d, k, frac = _polyline_nearest(pts, self.goal)
+            if d < best[1]:
+                best = (pts[k] + frac * (pts[k + 1] - pts[k]), d, f"vector {m}")
+        s = np.linspace(0, 1, 9)
+        uu, vv = (g.ravel() for g in np.meshgrid(s, s, indexing="ij"))
+        for family, name, _, fixed, _, x, conv in self._nets():
+            _, _, corners = _cells(x, conv)
+            if not len(corners):
+                continue
+            c = np.repeat(corners[:, :, self.c][:, None], len(uu), axis=1)  # (C, S, 4, 2)
+            p = _bilinear(c, np.broadcast_to(uu, c.shape[:2]), np.broadcast_to(vv, c.shape[:2]))
+            d = np.linalg.norm(p - self.goal, axis=-1)
+            k = np.unravel_index(np.argmin(d), d.shape)
+            if d[k] < best[1]:
+                best = (p[k], float(d[k]), f"{family} {name}")
+        return best
+
+
+@dataclass
+class Solution:
+    target: TargetSpec
+    jaw_forces: dict[str, float]
+    jaw_height_cm: float
+    chosen: Candidate
+    candidates: list[Candidate]  # every candidate, cheapest first
+    maps_note: str
+
+
+def solve_on(jm: JawMaps, target: TargetSpec) -> list[Candidate]:
+    """Every candidate force set on these maps that reaches the crucial feature, cheapest first."""
+    p = Problem(jm, target)
+    cands = [c for c in p.singles() + p.nets() if c.crucial_error <= target.crucial.tolerance_cm]
+    cands.sort(key=lambda c: c.cost)
+    if not cands:
+        point, dist, where = p.nearest_reachable()
+        if point is None:
+            raise UnreachableTarget(f"target '{target.name}': no settled EP maps to search")
+        raise UnreachableTarget(
+            f"target '{target.name}': {target.crucial.point} at ({target.crucial.at_cm[0]:.3f}, "
+            f"{target.crucial.at_cm[1]:.3f}) cm is not reachable at this jaw position; the nearest reachable point "
+            f"is ({point[0]:.3f}, {point[1]:.3f}) cm ({where}), {dist:.3f} cm away")
+    return cands

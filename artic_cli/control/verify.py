@@ -1,0 +1,113 @@
+"""Forward checks of a force set: simulate it, and (beyond the paper) refine it.
+
+A force set from the EP maps is checked by holding it, with the jaw force,
+from the jaw position's rest for the maps' duration (exactly how the maps were
+made) and reading the control points.  ``refine`` then corrects the free
+forces of the chosen candidate (the pair of a net, or a vector's muscle) by
+quasi-Newton steps: the first Jacobian comes from the map cell the candidate
+lies in, later ones from Broyden's update with each simulation.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..config import Config, load_config, model_hash
+from ..io.store import file_hash
+from .epmap import CONTROL_POINTS, JawMaps, _model, _rest, _sum, canonical, equilibrium_point
+from .solver import Candidate
+
+MAX_STEP_N = 1.5  # largest change of one force per refinement step
+
+
+class Simulator:
+    """The articulator of a mesh and config, with each jaw position's rest computed once (per process)."""
+
+    def __init__(self, mesh: Path | str, config: Path | str | None = None):
+        self.cfg: Config = load_config(config)
+        self.mesh = str(mesh)
+        self.key = model_hash(self.cfg) + file_hash(mesh)
+        self.cfg_json = json.dumps(self.cfg.model_dump(mode="json"))
+
+    def reach(self, jaw_forces: dict[str, float], forces: dict[str, float]) -> np.ndarray:
+        """(3, 3) tip, dorsum, jaw (cm) after holding the forces from the jaw position's rest."""
+        model = _model(self.key, self.cfg_json, self.mesh)
+        start = _rest(self.key, canonical(jaw_forces), self.cfg_json, self.mesh)
+        return equilibrium_point(model, start, _sum(dict(jaw_forces), forces), self.cfg.epmap).x
+
+
+@dataclass
+class Refinement:
+    forces: dict[str, float]
+    reached: np.ndarray  # (3, 3)
+    error: float  # crucial-feature error, cm
+    simulations: int
+    history: list[dict] = field(default_factory=list)
+
+
+def _free(candidate: Candidate) -> list[str]:
+    if candidate.family == "single":
+        return list(candidate.forces)
+    net = candidate.detail["net"]
+    a, b = net.split("+")[-2:]
+    return [a, b]
+
+
+def _map_jacobian(jm: JawMaps, candidate: Candidate, c: int, free: list[str]) -> np.ndarray:
+    """d(crucial point)/d(free forces) (2, n) from the map around the candidate."""
+    if candidate.family == "single":
+        net = jm.single[free[0]]
+        k = candidate.detail["segment"]
+        dp = net.x[k + 1, c, :2] - net.x[k, c, :2]
+        return (dp / (net.levels[0][k + 1] - net.levels[0][k]))[:, None]
+    name = candidate.detail["net"]
+    net = jm.pair.get(name) or jm.group[name]
+    x, levels = net.x, net.levels
+    if candidate.family == "group":
+        fixed = candidate.detail["fixed"][1]
+        k = int(np.argmin(np.abs(levels[0] - fixed)))
+        x, levels = x[k], levels[1:]
+    i, j = candidate.detail["cell"]
+    u, v = candidate.detail["uv"]
+    p00, p10, p01, p11 = x[i, j, c, :2], x[i + 1, j, c, :2], x[i, j + 1, c, :2], x[i + 1, j + 1, c, :2]
+    du = (1 - v) * (p10 - p00) + v * (p11 - p01)
+    dv = (1 - u) * (p01 - p00) + u * (p11 - p10)
+    return np.column_stack([du / (levels[0][i + 1] - levels[0][i]), dv / (levels[1][j + 1] - levels[1][j])])
+
+
+def refine(sim: Simulator, jm: JawMaps, jaw_forces: dict[str, float], candidate: Candidate, crucial: str,
+           goal: np.ndarray, tolerance: float, budget: int = 8, first: np.ndarray | None = None) -> Refinement:
+    """Correct the candidate's free forces until the simulated crucial point is within ``tolerance``."""
+    c = CONTROL_POINTS.index(crucial)
+    forces = dict(candidate.forces)
+    free = _free(candidate)
+    jac = _map_jacobian(jm, candidate, c, free)
+    reached = sim.reach(jaw_forces, forces) if first is None else first
+    sims = 1 if first is None else 0
+    err = goal - reached[c, :2]
+    history = [{"forces_n": dict(forces), "error_cm": float(np.linalg.norm(err))}]
+    best = (float(np.linalg.norm(err)), dict(forces), reached)
+    while best[0] > tolerance and sims < budget:
+        step, *_ = np.linalg.lstsq(jac, err, rcond=None)
+        step = np.clip(step, -MAX_STEP_N, MAX_STEP_N)
+        f = np.array([forces[m] for m in free])
+        new = np.maximum(f + step, 0.0)
+        step = new - f
+        if np.abs(step).max() < 1e-6:
+            break
+        trial = dict(forces)
+        trial.update({m: float(v) for m, v in zip(free, new)})
+        got = sim.reach(jaw_forces, trial)
+        sims += 1
+        new_err = goal - got[c, :2]
+        dr = got[c, :2] - reached[c, :2]
+        jac = jac + np.outer(dr - jac @ step, step) / float(step @ step)  # Broyden
+        forces, reached, err = trial, got, new_err
+        history.append({"forces_n": dict(forces), "error_cm": float(np.linalg.norm(err))})
+        if np.linalg.norm(err) < best[0]:
+            best = (float(np.linalg.norm(err)), dict(forces), reached)
+    return Refinement(forces=best[1], reached=best[2], error=best[0], simulations=sims, history=history)
