@@ -207,8 +207,11 @@ class Problem:
             ii, jj, corners = _cells(x, conv)
             if not len(ii):
                 continue
-            u, v, res = invert_cells(corners[:, :, self.c], self.goal)
-            inside = (u >= -1e-9) & (u <= 1 + 1e-9) & (v >= -1e-9) & (v <= 1 + 1e-9) & (res < 1e-6)
+            u, v, _ = invert_cells(corners[:, :, self.c], self.goal)
+            # outside a cell, its nearest edge point (Newton's solution clipped) may still be within tolerance
+            u, v = np.clip(u, 0.0, 1.0), np.clip(v, 0.0, 1.0)
+            res = np.linalg.norm(_bilinear(corners[:, :, self.c], u, v) - self.goal, axis=1)
+            inside = res <= self.t.crucial.tolerance_cm
             for k in np.flatnonzero(inside):
                 a, b = muscles[-2], muscles[-1]
                 la, lb = levels
@@ -218,7 +221,7 @@ class Problem:
                 forces[b] = forces.get(b, 0.0) + fb
                 if fixed is not None:
                     forces[fixed[0]] = forces.get(fixed[0], 0.0) + fixed[1]
-                pred = _bilinear(corners[k][None], np.array([u[k]]), np.array([v[k]]))[0]
+                pred = _bilinear(corners[k].reshape(1, 4, 4), np.array([u[k]]), np.array([v[k]]))[0].reshape(2, 2)
                 label = name if fixed is None else f"{name} ({fixed[0]} {fixed[1]:g} N)"
                 out.append(self._candidate(family, label, forces, pred,
                                            {"cell": [int(ii[k]), int(jj[k])], "uv": [float(u[k]), float(v[k])],

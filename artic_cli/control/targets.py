@@ -75,10 +75,14 @@ def forces_for_height(dm: DynamicMap, height: float) -> dict[str, float]:
     return {"JC": v} if v > 0 else ({"JO": -v} if v < 0 else {})
 
 
+def _num(v) -> float:
+    return round(float(v), 4)
+
+
 def _cand(c: Candidate) -> dict:
-    return {"family": c.family, "map": c.name, "forces_n": {k: round(v, 4) for k, v in c.forces.items()},
-            "predicted_cm": {k: [round(x, 4) for x in v] for k, v in c.predicted.items()},
-            "crucial_error_cm": round(c.crucial_error, 4), "cost": round(c.cost, 4)}
+    return {"family": c.family, "map": c.name, "forces_n": {k: _num(v) for k, v in c.forces.items()},
+            "predicted_cm": {k: [_num(x) for x in v] for k, v in c.predicted.items()},
+            "crucial_error_cm": _num(c.crucial_error), "cost": _num(c.cost)}
 
 
 def solve(ctx: Context, target: TargetSpec, simulator=None, verify: bool = False, refine: bool = False,
@@ -87,9 +91,9 @@ def solve(ctx: Context, target: TargetSpec, simulator=None, verify: bool = False
     jm, jaw_forces, height, how = jaw_maps(ctx, target)
     cands = solve_on(jm, target)
     chosen = cands[0]
-    doc = {"target": target.name, "jaw": {"forces_n": jaw_forces, "incisor_height_cm": round(height, 4),
+    doc = {"target": target.name, "jaw": {"forces_n": {k: _num(v) for k, v in jaw_forces.items()}, "incisor_height_cm": _num(height),
                                           "maps": how},
-           "crucial": {"point": target.crucial.point, "at_cm": list(target.crucial.at_cm),
+           "crucial": {"point": target.crucial.point, "at_cm": [float(v) for v in target.crucial.at_cm],
                        "tolerance_cm": target.crucial.tolerance_cm},
            "chosen": _cand(chosen), "candidates": [_cand(c) for c in cands[:TOP]],
            "candidates_considered": len(cands)}
@@ -100,16 +104,16 @@ def solve(ctx: Context, target: TargetSpec, simulator=None, verify: bool = False
         c = ("tip", "dorsum").index(target.crucial.point)
         reached = simulator.reach(jaw_forces, chosen.forces)
         err = float(np.linalg.norm(reached[c, :2] - goal))
-        doc["verified"] = {"reached_cm": {"tip": [round(v, 4) for v in reached[0, :2]],
-                                          "dorsum": [round(v, 4) for v in reached[1, :2]]},
-                           "crucial_error_cm": round(err, 4), "simulations": 1}
+        doc["verified"] = {"reached_cm": {"tip": [_num(v) for v in reached[0, :2]],
+                                          "dorsum": [_num(v) for v in reached[1, :2]]},
+                           "crucial_error_cm": _num(err), "simulations": 1}
         if refine:
             r = do_refine(simulator, jm, jaw_forces, chosen, target.crucial.point, goal,
                           target.crucial.tolerance_cm, budget=budget, first=reached)
-            doc["refined"] = {"forces_n": {k: round(v, 4) for k, v in r.forces.items()},
-                              "reached_cm": {"tip": [round(v, 4) for v in r.reached[0, :2]],
-                                             "dorsum": [round(v, 4) for v in r.reached[1, :2]]},
-                              "crucial_error_cm": round(r.error, 4), "simulations": 1 + r.simulations,
+            doc["refined"] = {"forces_n": {k: _num(v) for k, v in r.forces.items()},
+                              "reached_cm": {"tip": [_num(v) for v in r.reached[0, :2]],
+                                             "dorsum": [_num(v) for v in r.reached[1, :2]]},
+                              "crucial_error_cm": _num(r.error), "simulations": 1 + r.simulations,
                               "converged": bool(r.error <= target.crucial.tolerance_cm)}
     doc["provenance"] = {"epmaps_sha256": file_hash(ctx.maps_path),
                          "dynamic_sha256": None if ctx.dynamic_path is None else file_hash(ctx.dynamic_path)}

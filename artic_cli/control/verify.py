@@ -51,7 +51,7 @@ class Refinement:
 
 def _free(candidate: Candidate) -> list[str]:
     if candidate.family == "single":
-        return list(candidate.forces)
+        return [candidate.name]  # (its force may be 0: the jaw position's rest)
     net = candidate.detail["net"]
     a, b = net.split("+")[-2:]
     return [a, b]
@@ -94,7 +94,7 @@ def refine(sim: Simulator, jm: JawMaps, jaw_forces: dict[str, float], candidate:
     while best[0] > tolerance and sims < budget:
         step, *_ = np.linalg.lstsq(jac, err, rcond=None)
         step = np.clip(step, -MAX_STEP_N, MAX_STEP_N)
-        f = np.array([forces[m] for m in free])
+        f = np.array([forces.get(m, 0.0) for m in free])
         new = np.maximum(f + step, 0.0)
         step = new - f
         if np.abs(step).max() < 1e-6:

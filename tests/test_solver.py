@@ -1,0 +1,175 @@
+"""Dynamic maps and the target solver (issue 5): round trip, cost order, Table IV, bad input."""
+
+from __future__ import annotations
+
+import os
+import statistics
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+import yaml
+
+from artic_cli.control.dynamic import build_dynamic_map, derive, load_dynamic_map, table_iv
+from artic_cli.control.epmap import build_ep_maps
+from artic_cli.control.solver import parse_target
+from artic_cli.control.targets import load_context, read_batch, solve, solve_batch
+from artic_cli.control.verify import Simulator
+from artic_cli.errors import ArticError, UnreachableTarget
+
+from conftest import ROOT
+
+MUSCLES = ["SG", "GGp", "SL", "GGa", "HG", "GGm"]
+PAIRS = [["SG", "GGp"], ["SL", "GGa"], ["GGp", "HG"], ["GGm", "SG"], ["SL", "GGp"]]
+
+
+@pytest.fixture(scope="module")
+def maps(tmp_path_factory, mesh_file):
+    tmp = tmp_path_factory.mktemp("maps")
+    d = yaml.safe_load((ROOT / "configs" / "default.yaml").read_text())
+    d["epmap"] = {"jaw_positions": {"rest": {}, "JO_0.5": {"JO": 0.5}, "JO_2.5": {"JO": 2.5}, "JC_1.5": {"JC": 1.5}},
+                  "typical_jaw": "JO_0.5", "muscles": MUSCLES, "pairs_tip": PAIRS, "pairs_dorsum": [],
+                  "groups": [{"independent": "HG", "pair": ["GGp", "SL"]}], "group_levels_n": [0.2],
+                  "net_jaw_positions": ["JO_0.5"]}
+    cfg = tmp / "cfg.yaml"
+    cfg.write_text(yaml.safe_dump(d, sort_keys=False))
+    build_ep_maps(mesh_file, cfg, tmp / "maps.h5", jobs=2, cache=tmp / "cache")
+    build_dynamic_map(tmp / "maps.h5", tmp / "dynamic.h5")
+    return tmp, cfg
+
+
+def _target(tip, dorsum=None, tol=0.05, jaw=None):
+    data = {"name": "t", "crucial": {"point": "tip", "at_cm": [float(v) for v in tip], "tolerance_cm": tol}}
+    if dorsum is not None:
+        data["indecisive"] = [{"point": "dorsum", "at_cm": [float(v) for v in dorsum]}]
+    if jaw is not None:
+        data["jaw"] = jaw
+    return parse_target(data)
+
+
+def _round_trip(args):
+    """Simulate a force set, hand its tip (crucial) and dorsum (indecisive) to the solver, verify."""
+    k, mesh_file, cfg, tmp, forces = args
+    sim = Simulator(mesh_file, cfg)
+    reached = sim.reach({"JO": 0.5}, forces)
+    ctx = load_context(tmp / "maps.h5", tmp / "dynamic.h5")
+    target = _target(reached[0, :2], reached[1, :2])
+    doc = solve(ctx, target, sim, verify=True, refine=True)
+    return doc["verified"]["crucial_error_cm"], doc["refined"]["crucial_error_cm"], doc["refined"]["simulations"]
+
+
+def test_round_trip_of_twenty_random_force_sets(maps, mesh_file):
+    from joblib import Parallel, delayed
+
+    tmp, cfg = maps
+    rng = np.random.default_rng(2004)
+    sets = []
+    for _ in range(20):
+        a, b = PAIRS[rng.integers(len(PAIRS))]
+        sets.append({a: float(rng.uniform(0.2, 4.0)), b: float(rng.uniform(0.2, 4.0))})
+    res = Parallel(n_jobs=2)(delayed(_round_trip)((k, mesh_file, cfg, tmp, f)) for k, f in enumerate(sets))
+    plain = [r[0] for r in res]
+    refined = [r[1] for r in res]
+    print(f"\nround trip, crucial tip error: maps alone median {statistics.median(plain):.3f} max {max(plain):.3f} cm;"
+          f" with --refine median {statistics.median(refined):.3f} max {max(refined):.3f} cm, "
+          f"{sum(r[2] for r in res) / len(res):.1f} simulations per target")
+    assert statistics.median(refined) <= 0.05
+    assert max(refined) <= 0.15
+
+
+def test_chosen_force_set_is_the_cheapest_candidate(maps):
+    tmp, _ = maps
+    ctx = load_context(tmp / "maps.h5", tmp / "dynamic.h5")
+    rest = ctx.maps.jaws["JO_0.5"].rest
+    doc = solve(ctx, _target(rest[0, :2] + [-0.25, 0.2], rest[1, :2] + [-0.1, 0.05]))
+    costs = [c["cost"] for c in doc["candidates"]]
+    assert doc["candidates_considered"] >= 2
+    assert doc["chosen"]["cost"] <= min(costs) and costs == sorted(costs)
+    assert doc["chosen"]["crucial_error_cm"] <= 0.05
+
+
+def test_unreachable_target_names_the_nearest_point(maps):
+    tmp, _ = maps
+    ctx = load_context(tmp / "maps.h5", tmp / "dynamic.h5")
+    with pytest.raises(UnreachableTarget, match=r"not reachable.*nearest reachable point is \(.*\) cm .*cm away"):
+        solve(ctx, _target([2.0, 3.0]))
+
+
+def test_table_iv_is_computed_from_the_maps(maps):
+    tmp, _ = maps
+    ctx = load_context(tmp / "maps.h5", tmp / "dynamic.h5")
+    dm = load_dynamic_map(tmp / "dynamic.h5", maps_path=tmp / "maps.h5")
+    rows = {r["jaw"]: r for r in table_iv(dm)}
+    assert rows["JO_0.5"]["error_tip_cm"] == pytest.approx(0.0, abs=1e-9)
+    for jaw in ("rest", "JO_2.5", "JC_1.5"):
+        # recompute the mean error independently: derive the typical map at that jaw's height, compare vectors
+        sim = ctx.maps.jaws[jaw]
+        derived = derive(ctx.maps, dm, float(sim.rest[2, 1]))
+        errs = [np.linalg.norm(derived.single[m].x[:, 0, :2] - sim.single[m].x[:, 0, :2], axis=1) for m in MUSCLES]
+        assert rows[jaw]["error_tip_cm"] == pytest.approx(float(np.mean(np.concatenate(errs))), rel=1e-6)
+        assert 0 < rows[jaw]["error_tip_cm"] < 0.15 and rows[jaw]["loo_tip_cm"] is not None
+    assert rows["JO_2.5"]["position_cm"] < rows["rest"]["position_cm"] < rows["JC_1.5"]["position_cm"]
+
+
+def test_a_jaw_between_the_mapped_ones_uses_the_dynamic_map(maps):
+    tmp, _ = maps
+    ctx = load_context(tmp / "maps.h5", tmp / "dynamic.h5")
+    rest = ctx.maps.jaws["JO_0.5"].rest
+    doc = solve(ctx, _target(rest[0, :2] + [-0.2, 0.1], jaw={"forces_n": {"JO": 1.5}}))
+    assert "dynamic map" in doc["jaw"]["maps"] and doc["jaw"]["forces_n"] == {"JO": 1.5}
+    with pytest.raises(ArticError, match="outside the mapped jaw positions"):
+        solve(ctx, _target(rest[0, :2], jaw={"forces_n": {"JO": 9.0}}))
+
+
+def test_batch_solves_rows_and_marks_unreachable_ones(maps, tmp_path):
+    tmp, _ = maps
+    ctx = load_context(tmp / "maps.h5", tmp / "dynamic.h5")
+    x, y = ctx.maps.jaws["JO_0.5"].rest[0, :2]
+    csv = tmp_path / "b.csv"
+    csv.write_text("name,crucial,crucial_x_cm,crucial_y_cm,indecisive,indecisive_x_cm,indecisive_y_cm\n"
+                   f"a,tip,{x - 0.2},{y + 0.15},,,\nfar,tip,3,3,,,\n")
+    res = solve_batch(ctx, read_batch(csv), jobs=1)
+    assert "chosen" in res[0] and "unreachable" in res[1]
+
+
+BAD_TARGETS = {
+    "missing crucial": ("name: x\n", "missing key 'crucial'"),
+    "wrong type": ("crucial: {point: tip, at_cm: [a, 1]}\n", "crucial.at_cm"),
+    "no such point": ("crucial: {point: nose, at_cm: [0, 0]}\n", "no control point 'nose'"),
+    "unknown key": ("crucial: {point: tip, at_cm: [0, 0], tol: 1}\n", "unknown key 'crucial.tol'"),
+}
+
+
+def artic(*args):
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    return subprocess.run([sys.executable, "-m", "artic_cli.cli.main", *map(str, args)], capture_output=True,
+                          text=True, cwd=ROOT, env=env, timeout=300)
+
+
+@pytest.mark.parametrize("case", sorted(BAD_TARGETS))
+def test_bad_target_files_fail_in_one_line(case, maps, tmp_path):
+    tmp, _ = maps
+    body, needle = BAD_TARGETS[case]
+    f = tmp_path / "t.yaml"
+    f.write_text(body)
+    res = artic("solve-target", f, "--maps", tmp / "maps.h5", "--dynamic", tmp / "dynamic.h5",
+                "--out", tmp_path / "s.yaml")
+    assert res.returncode == 2 and "Traceback" not in res.stderr
+    lines = [ln for ln in res.stderr.splitlines() if ln.strip()]
+    assert len(lines) == 1 and needle in lines[0], res.stderr
+    assert not (tmp_path / "s.yaml").exists()
+
+
+def test_unreachable_exits_3_and_maps_from_another_mesh_exit_2(maps, tmp_path, mesh_file):
+    tmp, _ = maps
+    f = tmp_path / "t.yaml"
+    f.write_text("crucial: {point: tip, at_cm: [3, 3]}\n")
+    res = artic("solve-target", f, "--maps", tmp / "maps.h5", "--dynamic", tmp / "dynamic.h5", "--out",
+                tmp_path / "s.yaml")
+    assert res.returncode == 3 and "nearest reachable point" in res.stderr and "Traceback" not in res.stderr
+    other = tmp_path / "other.h5"
+    other.write_bytes(mesh_file.read_bytes() + b"\0")
+    res = artic("solve-target", f, "--maps", tmp / "maps.h5", "--dynamic", tmp / "dynamic.h5", "--verify",
+                "--mesh", other)
+    assert res.returncode == 2 and "another mesh" in res.stderr
