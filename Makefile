@@ -12,7 +12,7 @@ SRC    := $(shell find artic_cli -name '*.py') pyproject.toml
 SCHED  := configs/schedules
 SIMS   := $(OUT)/sims
 
-.PHONY: setup mesh sims cuboid experiments figures paper test bench clean
+.PHONY: setup mesh sims cuboid experiments epmaps dynamic solve figures paper test bench clean
 .DELETE_ON_ERROR:
 
 setup: $(VENV)/.installed
@@ -46,6 +46,25 @@ $(SIMS)/fig4_%.h5: $(SCHED)/fig4_%.yaml $(OUT)/mesh.h5
 $(SIMS)/art_%.h5: $(SCHED)/art_%.yaml $(OUT)/mesh.h5
 	$(ARTIC) simulate --schedule $< --mesh $(OUT)/mesh.h5 --config $(CONFIG) --out $@ --plot $(REPORT)/art_$*.png
 
+# EP maps (section IV.B), the dynamic map (IV.B.3), target solutions (V)
+epmaps: $(OUT)/epmaps.h5
+$(OUT)/epmaps.h5: $(OUT)/mesh.h5 $(CONFIG) $(SRC)
+	$(ARTIC) ep-map --mesh $(OUT)/mesh.h5 --config $(CONFIG) --out $@ --jobs 2 --cache $(OUT)/cache
+	$(ARTIC) plot ep-map --maps $@ --out $(REPORT)/fig8_epmap.png
+
+dynamic: $(OUT)/dynamic.h5
+$(OUT)/dynamic.h5: $(OUT)/epmaps.h5
+	$(ARTIC) dynamic-map --maps $< --out $@
+
+TARGETS   := $(wildcard configs/targets/*.yaml)
+SOLUTIONS := $(TARGETS:configs/targets/%.yaml=$(OUT)/solutions/%.yaml)
+solve: $(SOLUTIONS)
+$(OUT)/solutions/%.yaml: configs/targets/%.yaml $(OUT)/dynamic.h5
+	$(ARTIC) solve-target $< --maps $(OUT)/epmaps.h5 --dynamic $(OUT)/dynamic.h5 --mesh $(OUT)/mesh.h5 \
+	  --config $(CONFIG) --verify --refine --out $@ || [ $$? -eq 3 ]
+	$(ARTIC) plot solution $@ --target $< --maps $(OUT)/epmaps.h5 --dynamic $(OUT)/dynamic.h5 \
+	  --out $(REPORT)/fig12_$*.png
+
 # the paper's numeric experiments (section III), each a JSON table
 EXPS := jaw-ep fig4 muscle-directions k-closure stress
 EXP_FILES := $(EXPS:%=$(OUT)/experiments/%.json)
@@ -61,17 +80,19 @@ figures: mesh sims
 paper: $(REPORT)/paper.md
 $(REPORT)/paper.md: $(OUT)/mesh.h5 $(OUT)/cuboid.json $(SIMS)/gravity.h5 $(SIMS)/pull_2n.h5 \
                     $(SIMS)/pull_2n_novol.h5 $(SIMS)/stress_7n.h5 $(SIMS)/fig4_ggp.h5 $(SIMS)/fig4_sg.h5 \
-                    $(SIMS)/art_sg_jo.h5 $(EXP_FILES)
+                    $(SIMS)/art_sg_jo.h5 $(EXP_FILES) $(OUT)/epmaps.h5 $(OUT)/dynamic.h5 $(SOLUTIONS)
 	$(ARTIC) report --data $(OUT) --out $@
 
 # --- checks ---------------------------------------------------------------
 test: setup
 	$(PY) -m pytest
 
-bench: setup
+bench: setup $(OUT)/epmaps.h5 $(OUT)/dynamic.h5
 	$(PY) benchmarks/bench_tissue.py
 	$(PY) benchmarks/bench_articulator.py
 	$(PY) benchmarks/bench_epmap.py
+	$(PY) benchmarks/bench_solver.py
 
 clean:
-	rm -rf $(OUT)/*.h5 $(OUT)/*.json $(SIMS) $(OUT)/experiments $(REPORT)/*.png $(REPORT)/*.gif $(REPORT)/paper.md
+	rm -rf $(OUT)/*.h5 $(OUT)/*.json $(SIMS) $(OUT)/experiments $(OUT)/solutions $(OUT)/cache \
+	  $(REPORT)/*.png $(REPORT)/*.gif $(REPORT)/paper.md

@@ -78,6 +78,18 @@ def test_round_trip_of_twenty_random_force_sets(maps, mesh_file):
     assert max(refined) <= 0.15
 
 
+def test_refine_reaches_a_tight_tolerance_the_maps_alone_miss(maps, mesh_file):
+    tmp, cfg = maps
+    sim = Simulator(mesh_file, cfg)
+    ctx = load_context(tmp / "maps.h5", tmp / "dynamic.h5")
+    for forces in ({"SL": 3.7, "GGp": 2.2}, {"GGm": 2.0, "SG": 0.6}, {"SL": 1.3, "GGa": 3.5}):
+        reached = sim.reach({"JO": 0.5}, forces)
+        doc = solve(ctx, _target(reached[0, :2], reached[1, :2], tol=0.01), sim, verify=True, refine=True)
+        assert doc["refined"]["crucial_error_cm"] <= 0.01 < doc["verified"]["crucial_error_cm"] or \
+            doc["verified"]["crucial_error_cm"] <= 0.01
+        assert doc["refined"]["simulations"] <= 8
+
+
 def test_chosen_force_set_is_the_cheapest_candidate(maps):
     tmp, _ = maps
     ctx = load_context(tmp / "maps.h5", tmp / "dynamic.h5")

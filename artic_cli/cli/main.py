@@ -354,6 +354,11 @@ def solve_target_cmd(
                           f"{r['simulations']} simulations" + ("" if r["converged"] else " (tolerance not reached)"),
                           highlight=False)
     out_console.print(f"wrote {path}", highlight=False)
+    if "refined" in doc and not doc["refined"]["converged"]:
+        err_console.print(f"target '{t.name}' not reached within {t.crucial.tolerance_cm:g} cm after "
+                          f"{doc['refined']['simulations']} simulations (best {doc['refined']['crucial_error_cm']:.3f} "
+                          f"cm, written to {path}); raise --budget or the tolerance", highlight=False)
+        raise typer.Exit(3)
 
 
 plot_app = typer.Typer(no_args_is_help=True, help="Pictures of the artefacts.")

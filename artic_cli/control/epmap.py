@@ -13,7 +13,8 @@ jaw force held throughout).  A map is a family of EPs:
 Every EP is one task: (jaw position, muscle forces).  Tasks run in parallel
 through joblib (loky on one machine, dask.distributed on a cluster) and each
 result is cached on disk by ``joblib.Memory`` under a key made of the model
-hash (config without the map spec, plus the mesh file's hash) and the forces,
+hash (config without the map spec, the mesh file's hash and a hash of the
+physics source code) and the forces,
 so an interrupted build resumes, an unchanged one does nothing, and a changed
 map spec recomputes only the EPs it adds.
 """
@@ -203,6 +204,18 @@ def compute_rest(key: str, jaw_forces: Forces, cfg_json: str, mesh_path: str) ->
     return {"x": st.x[watch_nodes(model)].copy(), "mandible": st.x[model.node_sets["mandible"]].copy()}
 
 
+def physics_code_hash() -> str:
+    """Hash of the source an EP depends on (geometry, mechanics, config, this module): a cached EP from older
+    physics code is never reused."""
+    root = Path(__file__).resolve().parent.parent
+    files = sorted([*root.glob("geometry/*.py"), *root.glob("mechanics/*.py"), root / "config.py", root / "units.py",
+                    Path(__file__).resolve()])
+    h = hashlib.sha256()
+    for f in files:
+        h.update(f.read_bytes())
+    return h.hexdigest()
+
+
 def _spec_key(spec: EPMapSpec) -> str:
     """The parts of the spec an EP depends on (not the lists of what to compute)."""
     keep = {k: getattr(spec, k) for k in ("duration_ms", "convergence_window_ms", "convergence_tol_cm",
@@ -266,7 +279,8 @@ MAP_FORMAT = 3  # bump when the file layout changes: an old file is then rebuilt
 
 def inputs_hash(cfg: Config, mesh_sha: str, fast: bool) -> str:
     blob = json.dumps({"model": model_hash(cfg), "mesh": mesh_sha, "spec": cfg.epmap.model_dump(mode="json"),
-                       "fast": fast, "version": __version__, "format": MAP_FORMAT}, sort_keys=True)
+                       "fast": fast, "version": __version__, "format": MAP_FORMAT, "code": physics_code_hash()},
+                      sort_keys=True)
     return hashlib.sha256(blob.encode()).hexdigest()
 
 
@@ -288,7 +302,7 @@ def build_ep_maps(mesh: Path | str = "data/mesh.h5", config: Path | str | None =
     if not force and _stored_inputs(out) == wanted:
         return BuildResult(path=out, up_to_date=True)
     spec = cfg.epmap
-    key = hashlib.sha256((model_hash(cfg) + mesh_sha).encode()).hexdigest()
+    key = hashlib.sha256((model_hash(cfg) + mesh_sha + physics_code_hash()).encode()).hexdigest()
     cfg_json = json.dumps(cfg.model_dump(mode="json"))
     spec_json = _spec_key(spec)
     memory = Memory(Path(cache) if cache is not None else out.parent / "cache", verbose=0)

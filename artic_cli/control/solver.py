@@ -157,9 +157,10 @@ def _cells(net2: np.ndarray, conv: np.ndarray):
 class Problem:
     """A target on the maps of one jaw position."""
 
-    def __init__(self, jm: JawMaps, target: TargetSpec):
+    def __init__(self, jm: JawMaps, target: TargetSpec, reach: float | None = None):
         self.jm = jm
         self.t = target
+        self.reach = target.crucial.tolerance_cm if reach is None else reach
         self.c = CONTROL_POINTS.index(target.crucial.point)
         self.goal = np.asarray(target.crucial.at_cm, dtype=float)
 
@@ -185,7 +186,7 @@ class Problem:
                 continue
             pts = net.x[:stop, :2, :2]
             d, k, frac = _polyline_nearest(pts[:, self.c], self.goal)
-            if d > self.t.crucial.tolerance_cm:
+            if d > self.reach:
                 continue
             lv = net.levels[0]
             force = lv[k] + frac * (lv[k + 1] - lv[k])
@@ -211,7 +212,7 @@ class Problem:
             # outside a cell, its nearest edge point (Newton's solution clipped) may still be within tolerance
             u, v = np.clip(u, 0.0, 1.0), np.clip(v, 0.0, 1.0)
             res = np.linalg.norm(_bilinear(corners[:, :, self.c], u, v) - self.goal, axis=1)
-            inside = res <= self.t.crucial.tolerance_cm
+            inside = res <= self.reach
             for k in np.flatnonzero(inside):
                 a, b = muscles[-2], muscles[-1]
                 la, lb = levels
@@ -263,11 +264,18 @@ class Solution:
     maps_note: str
 
 
-def solve_on(jm: JawMaps, target: TargetSpec) -> list[Candidate]:
-    """Every candidate force set on these maps that reaches the crucial feature, cheapest first."""
-    p = Problem(jm, target)
-    cands = [c for c in p.singles() + p.nets() if c.crucial_error <= target.crucial.tolerance_cm]
-    cands.sort(key=lambda c: c.cost)
+def solve_on(jm: JawMaps, target: TargetSpec, reach: float | None = None) -> list[Candidate]:
+    """Every candidate force set on these maps that reaches the crucial feature, cheapest first.
+
+    ``reach`` (default: the crucial tolerance) is how close a candidate's predicted point must come; a
+    refinement by simulation may start from candidates a little farther out."""
+    tol = target.crucial.tolerance_cm
+    reach = tol if reach is None else max(reach, tol)
+    p = Problem(jm, target, reach)
+    found = p.singles() + p.nets()
+    cands = sorted([c for c in found if c.crucial_error <= tol], key=lambda c: c.cost)
+    if not cands:  # none on target by the maps: the near ones, nearest first, for a refinement to correct
+        cands = sorted([c for c in found if c.crucial_error <= reach], key=lambda c: (c.crucial_error, c.cost))
     if not cands:
         point, dist, where = p.nearest_reachable()
         if point is None:

@@ -19,6 +19,8 @@ from .epmap import EPMaps, JawMaps, canonical, load_ep_maps
 from .solver import Candidate, TargetSpec, parse_target, solve_on
 
 TOP = 5  # candidates listed in the output
+REFINE_REACH_CM = 0.1  # with --refine and no candidate on target, ones this close may start the correction
+REFINE_TRIES = 3  # candidates --refine may try in turn
 
 
 @dataclass
@@ -89,7 +91,7 @@ def solve(ctx: Context, target: TargetSpec, simulator=None, verify: bool = False
           budget: int = 8) -> dict:
     """Solve one target; returns the result document (plain data, units in the keys)."""
     jm, jaw_forces, height, how = jaw_maps(ctx, target)
-    cands = solve_on(jm, target)
+    cands = solve_on(jm, target, REFINE_REACH_CM if refine else None)
     chosen = cands[0]
     doc = {"target": target.name, "jaw": {"forces_n": {k: _num(v) for k, v in jaw_forces.items()}, "incisor_height_cm": _num(height),
                                           "maps": how},
@@ -108,12 +110,26 @@ def solve(ctx: Context, target: TargetSpec, simulator=None, verify: bool = False
                                           "dorsum": [_num(v) for v in reached[1, :2]]},
                            "crucial_error_cm": _num(err), "simulations": 1}
         if refine:
-            r = do_refine(simulator, jm, jaw_forces, chosen, target.crucial.point, goal,
-                          target.crucial.tolerance_cm, budget=budget, first=reached)
-            doc["refined"] = {"forces_n": {k: _num(v) for k, v in r.forces.items()},
+            # correct the cheapest candidate; if it cannot get there, the next ones, within the budget
+            left, best, tried = budget - 1, None, []
+            for k, cand in enumerate(cands[:REFINE_TRIES]):
+                first = reached if k == 0 else None
+                if k > 0 and left < 2:
+                    break
+                r = do_refine(simulator, jm, jaw_forces, cand, target.crucial.point, goal,
+                              target.crucial.tolerance_cm, budget=left, first=first)
+                left -= r.simulations
+                tried.append(f"{cand.family} {cand.name}")
+                if best is None or r.error < best[0].error:
+                    best = (r, cand)
+                if r.error <= target.crucial.tolerance_cm:
+                    break
+            r, cand = best
+            doc["refined"] = {"from": f"{cand.family} {cand.name}", "candidates_tried": tried,
+                              "forces_n": {k: _num(v) for k, v in r.forces.items()},
                               "reached_cm": {"tip": [_num(v) for v in r.reached[0, :2]],
                                              "dorsum": [_num(v) for v in r.reached[1, :2]]},
-                              "crucial_error_cm": _num(r.error), "simulations": 1 + r.simulations,
+                              "crucial_error_cm": _num(r.error), "simulations": budget - left,
                               "converged": bool(r.error <= target.crucial.tolerance_cm)}
     doc["provenance"] = {"epmaps_sha256": file_hash(ctx.maps_path),
                          "dynamic_sha256": None if ctx.dynamic_path is None else file_hash(ctx.dynamic_path)}
