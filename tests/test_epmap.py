@@ -195,3 +195,30 @@ def test_existing_maps_survive_a_failed_build(small, mesh_file, tmp_path):
         build_ep_maps(mesh_file, cfg, tmp / "maps.h5", cache=tmp / "cache")
     assert (tmp / "maps.h5").read_bytes() == before
     assert json.loads(json.dumps(list(load_ep_maps(tmp / "maps.h5").jaws))) == ["rest", "JO_0.5"]
+
+
+def test_an_interrupted_build_resumes_from_the_finished_equilibria(tmp_path, mesh_file):
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    cfg = _config(tmp_path, "resume", jaw_positions={"rest": {}}, typical_jaw="rest", muscles=["SL", "GGa", "V"],
+                  levels_n=[0.0, 0.5, 1.0, 2.0, 4.0], net_jaw_positions=[], pairs_tip=[], pairs_dorsum=[], groups=[])
+    cache, out = tmp_path / "cache", tmp_path / "maps.h5"
+    cmd = [sys.executable, "-m", "artic_cli.cli.main", "ep-map", "--mesh", str(mesh_file), "--config", cfg,
+           "--out", str(out), "--cache", str(cache), "--jobs", "1"]
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env, cwd=ROOT)
+    deadline = time.time() + 120
+    while time.time() < deadline and len(list(cache.rglob("output.pkl"))) < 4:
+        time.sleep(0.2)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130 and "rerun resumes" in err, err
+    assert not out.exists()  # nothing half-written
+    done = len(list(cache.rglob("output.pkl")))
+    res = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=ROOT, timeout=300)
+    assert res.returncode == 0, res.stderr
+    assert f"13 equilibria ({13 - done} computed, {done} from the cache)" in " ".join(res.stdout.split())
