@@ -12,7 +12,7 @@ SRC    := $(shell find artic_cli -name '*.py') pyproject.toml
 SCHED  := configs/schedules
 SIMS   := $(OUT)/sims
 
-.PHONY: setup mesh sims cuboid experiments epmaps dynamic solve figures paper test bench clean
+.PHONY: setup mesh sims cuboid experiments musclefunction epmaps dynamic solve figures paper test bench clean
 .DELETE_ON_ERROR:
 
 setup: $(VENV)/.installed
@@ -46,6 +46,12 @@ $(SIMS)/fig4_%.h5: $(SCHED)/fig4_%.yaml $(OUT)/mesh.h5
 $(SIMS)/art_%.h5: $(SCHED)/art_%.yaml $(OUT)/mesh.h5
 	$(ARTIC) simulate --schedule $< --mesh $(OUT)/mesh.h5 --config $(CONFIG) --out $@ --plot $(REPORT)/art_$*.png
 
+# muscle function from scattered starts (section IV.A.1, Figs. 5 and 6)
+musclefunction: $(OUT)/muscle_function.h5
+$(OUT)/muscle_function.h5: $(OUT)/mesh.h5 $(CONFIG) $(SRC)
+	$(ARTIC) muscle-function --mesh $(OUT)/mesh.h5 --config $(CONFIG) --out $@ --jobs 2 --cache $(OUT)/cache \
+	  --plot-dir $(REPORT)
+
 # EP maps (section IV.B), the dynamic map (IV.B.3), target solutions (V)
 epmaps: $(OUT)/epmaps.h5
 $(OUT)/epmaps.h5: $(OUT)/mesh.h5 $(CONFIG) $(SRC)
@@ -66,11 +72,13 @@ $(OUT)/solutions/%.yaml: configs/targets/%.yaml $(OUT)/dynamic.h5
 	  --out $(REPORT)/fig12_$*.png
 
 # the paper's numeric experiments (section III), each a JSON table
-EXPS := jaw-ep fig4 muscle-directions k-closure stress
+EXPS := jaw-ep fig4 muscle-directions k-closure stress fig7
 EXP_FILES := $(EXPS:%=$(OUT)/experiments/%.json)
 experiments: $(EXP_FILES)
 $(OUT)/experiments/%.json: $(OUT)/mesh.h5
 	$(ARTIC) experiment $* --mesh $(OUT)/mesh.h5 --config $(CONFIG) --out $@
+$(OUT)/experiments/fig7.json: $(OUT)/mesh.h5
+	$(ARTIC) experiment fig7 --mesh $(OUT)/mesh.h5 --config $(CONFIG) --out $@ --plot $(REPORT)/fig7_trajectories.png
 
 sims: $(SIMS)/gravity.h5 $(SIMS)/pull_2n.h5 $(SIMS)/pull_2n_novol.h5 $(SIMS)/stress_7n.h5 \
       $(SIMS)/fig4_ggp.h5 $(SIMS)/fig4_sg.h5 $(SIMS)/art_sg_jo.h5
@@ -80,7 +88,8 @@ figures: mesh sims
 paper: $(REPORT)/paper.md
 $(REPORT)/paper.md: $(OUT)/mesh.h5 $(OUT)/cuboid.json $(SIMS)/gravity.h5 $(SIMS)/pull_2n.h5 \
                     $(SIMS)/pull_2n_novol.h5 $(SIMS)/stress_7n.h5 $(SIMS)/fig4_ggp.h5 $(SIMS)/fig4_sg.h5 \
-                    $(SIMS)/art_sg_jo.h5 $(EXP_FILES) $(OUT)/epmaps.h5 $(OUT)/dynamic.h5 $(SOLUTIONS)
+                    $(SIMS)/art_sg_jo.h5 $(EXP_FILES) $(OUT)/epmaps.h5 $(OUT)/dynamic.h5 $(SOLUTIONS) \
+                    $(OUT)/muscle_function.h5
 	$(ARTIC) report --data $(OUT) --out $@
 
 # --- checks ---------------------------------------------------------------

@@ -185,6 +185,19 @@ class EPMapSpec(_Strict):
         return v
 
 
+class MuscleFunctionSpec(_Strict):
+    """The paper's section IV.A.1 (Figs. 5 and 6): scattered starts, then one muscle from each."""
+
+    start_combinations: list[Annotated[list[str], Field(min_length=1)]] = [
+        ["GGp", "GGm", "GGa"], ["GGp", "SG", "GGa"], ["HG", "GGm", "GGa"], ["HG", "SG", "GGa"]]
+    start_levels_n: list[NonNeg] = [0.0, 0.3, 0.8, 1.6, 3.2, 6.0]  # six levels, wider apart as they grow
+    start_ms: Positive = 120.0
+    muscles: list[str] = ["GGa", "GGm", "GGp", "HG", "SG", "SL", "IL", "V", "T", "MH"]
+    drive_force_n: Positive = 4.0
+    drive_ms: Positive = 150.0
+    contact: bool = False  # the paper left the wall out of this study
+
+
 class Cuboid(_Strict):
     size_cm: Point3 = [6.0, 3.0, 2.0]
     bricks: Annotated[list[int], Field(min_length=3, max_length=3)] = [5, 3, 2]
@@ -201,6 +214,7 @@ class Config(_Strict):
     contact: Contact = Contact()
     cuboid: Cuboid = Cuboid()
     epmap: EPMapSpec = EPMapSpec()
+    muscle_function: MuscleFunctionSpec = MuscleFunctionSpec()
 
 
 
@@ -272,7 +286,7 @@ def config_hash(cfg: Config) -> str:
 
 def model_hash(cfg: Config) -> str:
     """Hash of what a simulation depends on: everything but the experiment and map specifications."""
-    return _digest(cfg.model_dump(mode="json", exclude={"cuboid", "epmap"}))
+    return _digest(cfg.model_dump(mode="json", exclude={"cuboid", "epmap", "muscle_function"}))
 
 
 def geometry_hash(cfg: Config) -> str:

@@ -139,6 +139,43 @@ def articulator_rows(data: Path) -> list[Row]:
     return rows
 
 
+def function_rows(data: Path) -> tuple[list[Row], list[str]]:
+    """Section IV.A.1 (Figs. 5 and 6) and Fig. 7."""
+    from .experiments.muscle_function import convergence, load_muscle_function
+    from .experiments.paper import PAPER_DIRECTIONS
+
+    rows: list[Row] = []
+    mf = load_muscle_function(data / "muscle_function.h5")
+    for r in convergence(mf):
+        paper = PAPER_DIRECTIONS.get(r["muscle"], {}).get(r["point"])
+        d = np.array(r["mean_end_from_rest_cm"])
+        ang = float(np.degrees(np.arctan2(d[1], d[0])))
+        if paper is not None:
+            err = float(np.degrees(np.arccos(np.clip(d @ np.array(paper) / max(np.linalg.norm(d), 1e-12), -1, 1))))
+            verdict = _verdict(err <= 45 and r["end_spread_cm"] < r["start_spread_cm"],
+                               f"{err:.0f} deg from the paper's direction; spread {r['start_spread_cm']:.2f} -> "
+                               f"{r['end_spread_cm']:.2f} cm")
+            paper_txt = "converges, " + {(0, 1): "up", (0, -1): "down", (-1, 0): "back", (1, 0): "front"}.get(
+                tuple(np.round(paper).astype(int)), f"{np.degrees(np.arctan2(paper[1], paper[0])):+.0f} deg")
+        else:
+            verdict = _verdict(r["end_spread_cm"] < r["start_spread_cm"],
+                               f"spread {r['start_spread_cm']:.2f} -> {r['end_spread_cm']:.2f} cm; no definite "
+                               "direction in the paper")
+            paper_txt = "converges"
+        rows.append(Row(f"Figs. 5/6: {r['muscle']} from {len(mf.starts)} starts, {r['point']}", paper_txt,
+                        f"ends {np.linalg.norm(d):.2f} cm from rest at {ang:+.0f} deg, spread "
+                        f"{r['end_spread_cm']:.3f} cm", verdict))
+    f7 = _experiment(data, "fig7")
+    spreads = [r for k, r in f7.items() if "spread" in k]
+    worst = max(spreads, key=lambda r: r["ours"])
+    rows.append(Row(f"Fig. 7: {len(spreads) // 2} muscle/force cases from four starting shapes, 400 ms",
+                    "one EP per force, whatever the start", f"end points within {worst['ours']:.3f} cm "
+                    f"(worst: {worst['name'].split(':')[0]})", _verdict(worst["ours"] <= 0.05, "goal <= 0.05 cm")))
+    lines = ["![Fig. 5: tip](fig5_muscle_function_tip.png)", "![Fig. 6: dorsum](fig6_muscle_function_dorsum.png)",
+             "![Fig. 7: trajectories](fig7_trajectories.png)", ""]
+    return rows, lines
+
+
 def map_rows(data: Path) -> tuple[list[Row], list[str]]:
     """Section IV.B (EP maps, Table III, Table IV) and section V (solutions): rows and extra lines."""
     from .control.dynamic import load_dynamic_map, table_iv
@@ -225,6 +262,10 @@ def write_report(data: Path | str = "data", out: Path | str = "reports/paper.md"
               "(fig4_ggp.png)", "", "Animations: [fig4_sg.gif](fig4_sg.gif), [fig4_ggp.gif](fig4_ggp.gif).", "",
               "| item | paper | ours | verdict |", "|---|---|---|---|"]
     lines += [f"| {r.item} | {r.paper} | {r.ours} | {r.verdict} |" for r in articulator_rows(data)]
+    rows, extra = function_rows(data)
+    lines += ["", "## Muscle function and equilibrium positions (section IV.A)", ""] + extra
+    lines += ["| item | paper | ours | verdict |", "|---|---|---|---|"]
+    lines += [f"| {r.item} | {r.paper} | {r.ours} | {r.verdict} |" for r in rows]
     rows, extra = map_rows(data)
     lines += ["", "## EP maps, dynamic maps and the target solver (sections IV.B and V)", ""] + extra
     lines += ["", "| item | paper | ours | verdict |", "|---|---|---|---|"]

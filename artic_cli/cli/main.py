@@ -170,11 +170,12 @@ def validate_cuboid_cmd(
 @app.command("experiment")
 @handle_errors
 def experiment_cmd(
-    name: str = typer.Argument(..., help="jaw-ep, fig4, muscle-directions, k-closure or stress."),
+    name: str = typer.Argument(..., help="jaw-ep, fig4, muscle-directions, k-closure, stress or fig7."),
     mesh: Path = typer.Option(Path("data/mesh.h5"), "--mesh", help="Mesh artefact from build-mesh."),
     config: Optional[Path] = typer.Option(None, "--config", help="Config the mesh was built from."),
     as_json: bool = typer.Option(False, "--json", help="Print the table as JSON."),
     out: Optional[Path] = typer.Option(None, "--out", help="Also write the rows as JSON to this file."),
+    plot: Optional[Path] = typer.Option(None, "--plot", help="fig7 only: draw the trajectories (PNG)."),
 ):
     """Reproduce one of the paper's numeric experiments, ours beside the paper's."""
     from ..config import config_hash
@@ -184,8 +185,10 @@ def experiment_cmd(
 
     if name not in EXPERIMENTS:
         raise ArticError(f"unknown experiment '{name}'; valid: {', '.join(EXPERIMENTS)}")
+    if plot is not None and name != "fig7":
+        raise ArticError(f"--plot is for 'fig7'; experiment '{name}' prints a table only")
     model, cfg, _ = load_model(mesh, config)
-    rows = EXPERIMENTS[name](model)
+    rows = EXPERIMENTS[name](model, plot=plot) if plot is not None else EXPERIMENTS[name](model)
     if out is not None:
         doc = {"experiment": name, "config_hash": config_hash(cfg), "mesh_sha256": file_hash(mesh),
                "rows": rows_as_dicts(rows)}
@@ -258,6 +261,47 @@ def ep_map_cmd(
         table.add_row(m, f"{ft:.2f}", "" if pt is None else f"{pt:.2f}", f"{fd:.2f}", "" if pd is None else f"{pd:.2f}",
                       f"{at:.3f}", f"{ad:.3f}")
     out_console.print(table)
+
+
+@app.command("muscle-function")
+@handle_errors
+def muscle_function_cmd(
+    mesh: Path = typer.Option(Path("data/mesh.h5"), "--mesh", help="Mesh artefact from build-mesh."),
+    config: Optional[Path] = typer.Option(None, "--config", help="Config (its 'muscle_function' section sets the "
+                                                                 "grid; thin start_levels_n for a quick run)."),
+    out: Path = typer.Option(Path("data/muscle_function.h5"), "--out", help="Starts and end points (HDF5)."),
+    jobs: int = typer.Option(2, "--jobs", help="Parallel workers."),
+    cache: Optional[Path] = typer.Option(None, "--cache", help="Where finished starts are kept for resuming."),
+    plot_dir: Optional[Path] = typer.Option(None, "--plot-dir", help="Also draw Figs. 5 and 6 into this folder."),
+):
+    """Section IV.A.1: each muscle at 4 N for 150 ms from scattered starts (Figs. 5 and 6)."""
+    from ..experiments.muscle_function import build_muscle_function, convergence
+
+    bar, update = _progress("starts", plain=True)
+    try:
+        if bar is not None:
+            with bar:
+                mf, wall, cached = build_muscle_function(mesh, config, out, jobs, cache, update)
+        else:
+            mf, wall, cached = build_muscle_function(mesh, config, out, jobs, cache, update)
+    except KeyboardInterrupt:
+        err_console.print(f"interrupted; {out} was not touched, finished starts are cached and a rerun resumes")
+        raise typer.Exit(130) from None
+    out_console.print(f"wrote {out}: {len(mf.starts)} starts x {len(mf.muscles)} muscles ({cached} starts from the "
+                      f"cache) in {wall:.1f} s", highlight=False)
+    table = Table(title=f"Where each muscle drives the control points ({mf.drive_n:g} N, {mf.drive_ms:g} ms)")
+    for col in ("muscle", "point", "start spread cm", "end spread cm", "mean end - rest, x / y cm"):
+        table.add_column(col, justify="left" if col in ("muscle", "point") else "right")
+    for r in convergence(mf):
+        dx, dy = r["mean_end_from_rest_cm"]
+        table.add_row(r["muscle"], r["point"], f"{r['start_spread_cm']:.3f}", f"{r['end_spread_cm']:.3f}",
+                      f"{dx:+.3f} / {dy:+.3f}")
+    out_console.print(table)
+    if plot_dir is not None:
+        from ..plots.muscle_function import plot_muscle_function
+
+        for point, fig in (("tip", "fig5_muscle_function_tip.png"), ("dorsum", "fig6_muscle_function_dorsum.png")):
+            out_console.print(f"wrote {plot_muscle_function(mf, point, Path(plot_dir) / fig)}", highlight=False)
 
 
 @app.command("dynamic-map")

@@ -172,24 +172,40 @@ STRESS_MUSCLES = ("GGp", "SG", "HG", "SL", "IL")
 FIG7_STARTS = (("SL", "GGa"), ("SG", "HG"), ("GGp", "GGm"), ("IL", "V"))  # four starting shapes, 5 N each
 
 
-def fig7(model: Model, muscles=("GGp", "SG"), forces=(1.0, 2.0, 3.5, 5.0), duration: float = 0.4) -> list[Row]:
-    """Fig. 7: one muscle from four different starting shapes reaches one EP per force level."""
+def fig7_paths(model: Model, muscles=("GGp", "GGm", "SG"), forces=(1.0, 2.0, 3.5, 5.0), duration: float = 0.4):
+    """Fig. 7: for each muscle and force, the tip/dorsum/jaw paths (F, 4 starts, T, 3, 3) from four starting
+    shapes (two-muscle combinations at 5 N each, 300 ms) under that force alone; and the audit."""
     rest = settle(model)
-    pts = _points(model)
     audit = Audit(model)
+    watch = [int(model.node_sets[k][0]) for k in ("tip", "dorsum", "jaw")]
     starts = [audit.run(rest, {m: 5.0 for m in combo}, 0.3)[1] for combo in FIG7_STARTS]
-    rows = []
+    data = {}
     for muscle in muscles:
-        for force in forces:
-            ends = np.array([audit.run(s, {muscle: force}, duration)[1].x for s in starts])
-            for cp in ("tip", "dorsum"):
-                p = ends[:, pts[cp]]
+        paths = np.array([[audit.run(s, {muscle: f}, duration)[0].x[:, watch] for s in starts] for f in forces])
+        data[muscle] = {"forces": list(forces), "paths": paths}
+    return data, audit
+
+
+def fig7(model: Model, muscles=("GGp", "GGm", "SG"), forces=(1.0, 2.0, 3.5, 5.0), duration: float = 0.4,
+         plot=None) -> list[Row]:
+    """Fig. 7: one muscle from four different starting shapes reaches one EP per force level."""
+    data, audit = fig7_paths(model, muscles, forces, duration)
+    rows = []
+    for muscle, d in data.items():
+        for f_i, force in enumerate(d["forces"]):
+            for c, cp in enumerate(("tip", "dorsum")):
+                p = d["paths"][f_i, :, -1, c]
                 spread = max(float(np.linalg.norm(a - b)) for a in p for b in p)
-                moved = min(float(np.linalg.norm(p[k] - s.x[pts[cp]])) for k, s in enumerate(starts))
+                moved = float(np.linalg.norm(d["paths"][f_i, :, -1, c] - d["paths"][f_i, :, 0, c], axis=1).min())
                 rows.append(Row(f"{muscle} {force:g} N {cp}: spread of the four end points", spread, None, "cm",
-                                f"starts {' / '.join('+'.join(c) for c in FIG7_STARTS)} at 5 N; "
+                                f"starts {' / '.join('+'.join(cb) for cb in FIG7_STARTS)} at 5 N; "
                                 f"each moved at least {moved:.2f} cm"))
+    if plot is not None:
+        from ..plots.muscle_function import plot_fig7
+
+        plot_fig7(data, plot)
     return rows + audit.rows()
+
 
 EXPERIMENTS = {"jaw-ep": jaw_ep, "fig4": fig4, "muscle-directions": muscle_directions, "k-closure": k_closure,
                "stress": stress, "fig7": fig7}

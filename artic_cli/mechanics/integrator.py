@@ -254,7 +254,7 @@ def _step_once(model: Model, state: State, control: Control, h: float) -> State:
     act = total_activation(model, control.activation)
     key = (c_a, c_v)
     base = state.factor.base if state.factor is not None and state.factor.key == key else None
-    factor = None
+    factor = state.factor if base is not None else None  # rank-one part too, while the contact set holds
     prev = None
     fresh = False
     fs = None
