@@ -189,3 +189,29 @@ def test_failed_write_leaves_no_file(tmp_path):
             f.create_dataset("x", data=np.arange(3))
             raise RuntimeError("interrupted")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_export_writes_paraview_files_and_ema_csv(mesh_file, tmp_path):
+    import meshio
+
+    sched = tmp_path / "sl.yaml"
+    sched.write_text("duration_ms: 20\nmuscles:\n  - {muscle: SL, force_n: 2, onset_ms: 0, duration_ms: 20}\n")
+    sim = tmp_path / "sl.h5"
+    assert artic("simulate", "--schedule", sched, "--mesh", mesh_file, "--out", sim).returncode == 0
+    res = artic("export", "--mesh", mesh_file, "--sim", sim, "--vtk", tmp_path / "vtk", "--csv", tmp_path / "sl.csv")
+    assert res.returncode == 0, res.stderr
+    tongue = meshio.read(tmp_path / "vtk" / "mesh.vtu")
+    assert tongue.cells_dict["hexahedron"].shape == (120, 8)
+    frame = meshio.read(tmp_path / "vtk" / "sl_0004.vtu")
+    assert frame.points.shape[0] > 231 and "line" in frame.cells_dict  # tongue + jaw and hyoid
+    with meshio.xdmf.TimeSeriesReader(tmp_path / "vtk" / "sl.xdmf") as r:
+        r.read_points_cells()
+        assert r.num_steps == 5
+        t, pd, _ = r.read_data(4)
+        assert t == pytest.approx(0.02) and np.abs(pd["displacement"]).max() > 0.01
+    assert "sl_0004.vtu" in (tmp_path / "vtk" / "sl.pvd").read_text()
+    rows = (tmp_path / "sl.csv").read_text().splitlines()
+    assert rows[0] == "time_s," + ",".join(f"{p}_{a}_cm" for p in ("tip", "dorsum", "jaw") for a in "xyz")
+    assert len(rows) == 6
+    bad = artic("export", "--mesh", mesh_file, "--csv", tmp_path / "x.csv")
+    assert_one_line_error(bad, "--sim")

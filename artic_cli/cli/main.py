@@ -405,6 +405,37 @@ def solve_target_cmd(
         raise typer.Exit(3)
 
 
+@app.command("export")
+@handle_errors
+def export_cmd(
+    mesh: Path = typer.Option(Path("data/mesh.h5"), "--mesh", help="Mesh artefact from build-mesh."),
+    sim: Optional[Path] = typer.Option(None, "--sim", help="A simulation from 'artic simulate' to export."),
+    vtk: Optional[Path] = typer.Option(None, "--vtk", help="Folder for VTK (.vtu + .pvd) and XDMF files "
+                                                           "(ParaView)."),
+    csv_out: Optional[Path] = typer.Option(None, "--csv", help="CSV of the control points (time, tip, dorsum, "
+                                                               "jaw x/y/z in cm); needs --sim."),
+    every: int = typer.Option(1, "--every", help="Export every n-th recorded frame (VTK)."),
+):
+    """Write the mesh and simulations for ParaView (VTK/XDMF) and control points as CSV (EMA layout)."""
+    from ..io.export import export_csv, export_mesh_vtk, export_simulation_vtk
+
+    if vtk is None and csv_out is None:
+        raise ArticError("nothing to export; give --vtk FOLDER and/or --csv FILE")
+    if csv_out is not None and sim is None:
+        raise ArticError("--csv exports a simulation's control points; give --sim FILE.h5")
+    if every < 1:
+        raise ArticError(f"--every must be at least 1, got {every}")
+    written = []
+    if vtk is not None:
+        written += export_mesh_vtk(mesh, vtk)
+        if sim is not None:
+            written += export_simulation_vtk(sim, mesh, vtk, every)
+    if csv_out is not None:
+        written.append(export_csv(sim, csv_out))
+    shown = ", ".join(str(p) for p in written[:4]) + (f" and {len(written) - 4} more" if len(written) > 4 else "")
+    out_console.print(f"wrote {shown}", highlight=False)
+
+
 plot_app = typer.Typer(no_args_is_help=True, help="Pictures of the artefacts.")
 app.add_typer(plot_app, name="plot", help="Pictures of the artefacts (EP maps, ...).")
 
