@@ -1,10 +1,14 @@
 # artic: reproducible runs.  `make setup && make paper` builds every stage and the report;
 # `make setup && make test` runs the tests.  Stages rerun only when their inputs changed.
-PYTHON ?= python3
-VENV   ?= .venv
-CONFIG ?= configs/default.yaml
-OUT    ?= data
-REPORT ?= reports
+# Another speaker: `make paper CONFIG=configs/other.yaml OUT=data/other/` (its report goes to OUT/reports).
+# What the paper pipeline builds (schedules, experiments, targets) is listed in $(PIPELINE).
+PYTHON   ?= python3
+VENV     ?= .venv
+CONFIG   ?= configs/default.yaml
+OUT      ?= data
+OUT      := $(patsubst %/,%,$(OUT))
+REPORT   ?= $(if $(filter data,$(OUT)),reports,$(OUT)/reports)
+PIPELINE ?= pipelines/paper.yaml
 
 PY     := $(VENV)/bin/python
 ARTIC  := $(VENV)/bin/artic
@@ -22,6 +26,19 @@ $(VENV)/.installed: pyproject.toml
 	$(VENV)/bin/pip install --quiet -e '.[test]'
 	touch $@
 
+# the pipeline's lists (TISSUE_SIMS, NOVOL_SIMS, ART_SIMS, ANIMATED, EXPS, TARGET_NAMES), rendered from YAML
+PIPELINE_MK := $(OUT)/.pipeline.mk
+ifeq ($(filter setup test clean,$(MAKECMDGOALS)),)
+-include $(PIPELINE_MK)
+endif
+$(PIPELINE_MK): $(PIPELINE) $(SRC) | setup
+	@mkdir -p $(OUT)
+	$(PY) -m artic_cli.pipeline $(PIPELINE) > $@.tmp && mv $@.tmp $@
+
+# a missing config stops the first stage with one line
+$(CONFIG):
+	@echo "error: config not found: $@; give an existing file, e.g. CONFIG=configs/default.yaml" >&2; exit 2
+
 # --- stages ---------------------------------------------------------------
 mesh: $(OUT)/mesh.h5
 $(OUT)/mesh.h5: $(CONFIG) $(SRC) | setup
@@ -31,20 +48,28 @@ cuboid: $(OUT)/cuboid.json
 $(OUT)/cuboid.json: $(CONFIG) $(SRC) | setup
 	$(ARTIC) validate cuboid --config $(CONFIG) --out $@
 
-# the tissue model alone (section II): node-set loads, GG tendon and floor held
-$(SIMS)/%_novol.h5: $(SCHED)/%.yaml $(OUT)/mesh.h5
-	$(ARTIC) simulate --tongue-only --schedule $< --mesh $(OUT)/mesh.h5 --config $(CONFIG) --out $@ --no-volume-constraint
+# simulations: the tissue model alone (section II, GG tendon and floor held) and the whole articulator (III)
+TISSUE_FILES := $(TISSUE_SIMS:%=$(SIMS)/%.h5)
+NOVOL_FILES  := $(NOVOL_SIMS:%=$(SIMS)/%_novol.h5)
+ART_FILES    := $(ART_SIMS:%=$(SIMS)/%.h5)
+SIM_FILES    := $(TISSUE_FILES) $(NOVOL_FILES) $(ART_FILES)
+sims: $(SIM_FILES)
+$(TISSUE_FILES): $(SIMS)/%.h5: $(SCHED)/%.yaml $(OUT)/mesh.h5
+	$(ARTIC) simulate --tongue-only --schedule $< --mesh $(OUT)/mesh.h5 --config $(CONFIG) --out $@ \
+	  --plot $(REPORT)/sim_$*.png
+$(NOVOL_FILES): $(SIMS)/%_novol.h5: $(SCHED)/%.yaml $(OUT)/mesh.h5
+	$(ARTIC) simulate --tongue-only --schedule $< --mesh $(OUT)/mesh.h5 --config $(CONFIG) --out $@ \
+	  --no-volume-constraint
+$(ART_FILES): $(SIMS)/%.h5: $(SCHED)/%.yaml $(OUT)/mesh.h5
+	$(ARTIC) simulate --schedule $< --mesh $(OUT)/mesh.h5 --config $(CONFIG) --out $@ --plot $(REPORT)/$*.png \
+	  $(if $(filter $*,$(ANIMATED)),--animate $(REPORT)/$*.gif)
 
-$(SIMS)/%.h5: $(SCHED)/%.yaml $(OUT)/mesh.h5
-	$(ARTIC) simulate --tongue-only --schedule $< --mesh $(OUT)/mesh.h5 --config $(CONFIG) --out $@ --plot $(REPORT)/sim_$*.png
-
-# the whole articulator (section III): muscle schedules
-$(SIMS)/fig4_%.h5: $(SCHED)/fig4_%.yaml $(OUT)/mesh.h5
-	$(ARTIC) simulate --schedule $< --mesh $(OUT)/mesh.h5 --config $(CONFIG) --out $@ --plot $(REPORT)/fig4_$*.png \
-	  --animate $(REPORT)/fig4_$*.gif
-
-$(SIMS)/art_%.h5: $(SCHED)/art_%.yaml $(OUT)/mesh.h5
-	$(ARTIC) simulate --schedule $< --mesh $(OUT)/mesh.h5 --config $(CONFIG) --out $@ --plot $(REPORT)/art_$*.png
+# the paper's numeric experiments (section III and Fig. 7), each a JSON table
+EXP_FILES := $(EXPS:%=$(OUT)/experiments/%.json)
+experiments: $(EXP_FILES)
+$(OUT)/experiments/%.json: $(OUT)/mesh.h5
+	$(ARTIC) experiment $* --mesh $(OUT)/mesh.h5 --config $(CONFIG) --out $@ \
+	  $(if $(filter fig7,$*),--plot $(REPORT)/fig7_trajectories.png)
 
 # muscle function from scattered starts (section IV.A.1, Figs. 5 and 6)
 musclefunction: $(OUT)/muscle_function.h5
@@ -62,8 +87,7 @@ dynamic: $(OUT)/dynamic.h5
 $(OUT)/dynamic.h5: $(OUT)/epmaps.h5
 	$(ARTIC) dynamic-map --maps $< --out $@
 
-TARGETS   := $(wildcard configs/targets/*.yaml)
-SOLUTIONS := $(TARGETS:configs/targets/%.yaml=$(OUT)/solutions/%.yaml)
+SOLUTIONS := $(TARGET_NAMES:%=$(OUT)/solutions/%.yaml)
 solve: $(SOLUTIONS)
 $(OUT)/solutions/%.yaml: configs/targets/%.yaml $(OUT)/dynamic.h5
 	$(ARTIC) solve-target $< --maps $(OUT)/epmaps.h5 --dynamic $(OUT)/dynamic.h5 --mesh $(OUT)/mesh.h5 \
@@ -71,25 +95,11 @@ $(OUT)/solutions/%.yaml: configs/targets/%.yaml $(OUT)/dynamic.h5
 	$(ARTIC) plot solution $@ --target $< --maps $(OUT)/epmaps.h5 --dynamic $(OUT)/dynamic.h5 \
 	  --out $(REPORT)/fig12_$*.png
 
-# the paper's numeric experiments (section III), each a JSON table
-EXPS := jaw-ep fig4 muscle-directions k-closure stress fig7
-EXP_FILES := $(EXPS:%=$(OUT)/experiments/%.json)
-experiments: $(EXP_FILES)
-$(OUT)/experiments/%.json: $(OUT)/mesh.h5
-	$(ARTIC) experiment $* --mesh $(OUT)/mesh.h5 --config $(CONFIG) --out $@
-$(OUT)/experiments/fig7.json: $(OUT)/mesh.h5
-	$(ARTIC) experiment fig7 --mesh $(OUT)/mesh.h5 --config $(CONFIG) --out $@ --plot $(REPORT)/fig7_trajectories.png
-
-sims: $(SIMS)/gravity.h5 $(SIMS)/pull_2n.h5 $(SIMS)/pull_2n_novol.h5 $(SIMS)/stress_7n.h5 \
-      $(SIMS)/fig4_ggp.h5 $(SIMS)/fig4_sg.h5 $(SIMS)/art_sg_jo.h5
-
-figures: mesh sims
+figures: mesh sims experiments musclefunction epmaps solve
 
 paper: $(REPORT)/paper.md
-$(REPORT)/paper.md: $(OUT)/mesh.h5 $(OUT)/cuboid.json $(SIMS)/gravity.h5 $(SIMS)/pull_2n.h5 \
-                    $(SIMS)/pull_2n_novol.h5 $(SIMS)/stress_7n.h5 $(SIMS)/fig4_ggp.h5 $(SIMS)/fig4_sg.h5 \
-                    $(SIMS)/art_sg_jo.h5 $(EXP_FILES) $(OUT)/epmaps.h5 $(OUT)/dynamic.h5 $(SOLUTIONS) \
-                    $(OUT)/muscle_function.h5
+$(REPORT)/paper.md: $(OUT)/mesh.h5 $(OUT)/cuboid.json $(SIM_FILES) $(EXP_FILES) $(OUT)/muscle_function.h5 \
+                    $(OUT)/epmaps.h5 $(OUT)/dynamic.h5 $(SOLUTIONS)
 	$(ARTIC) report --data $(OUT) --out $@
 
 # --- checks ---------------------------------------------------------------
@@ -103,5 +113,5 @@ bench: setup $(OUT)/epmaps.h5 $(OUT)/dynamic.h5
 	$(PY) benchmarks/bench_solver.py
 
 clean:
-	rm -rf $(OUT)/*.h5 $(OUT)/*.json $(SIMS) $(OUT)/experiments $(OUT)/solutions $(OUT)/cache \
+	rm -rf $(OUT)/*.h5 $(OUT)/*.json $(SIMS) $(OUT)/experiments $(OUT)/solutions $(OUT)/cache $(PIPELINE_MK) \
 	  $(REPORT)/*.png $(REPORT)/*.gif $(REPORT)/paper.md

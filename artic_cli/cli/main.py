@@ -17,7 +17,7 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 from rich.table import Table
 
-from ..errors import ArticError
+from ..errors import ArticError, UnreachableTarget
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
                   help="A physiological articulatory model of the tongue, jaw and hyoid (after Dang & Honda 2004).")
@@ -380,8 +380,12 @@ def solve_target_cmd(
         from ..control.verify import Simulator
 
         sim = Simulator(mesh, config)
-    doc = solve(ctx, t, sim, verify, refine, budget)
     path = out or Path("data/solutions") / f"{t.name}.yaml"
+    try:
+        doc = solve(ctx, t, sim, verify, refine, budget)
+    except UnreachableTarget as err:  # the answer is written too (make and scripts can report it)
+        write_solution(path, {"target": t.name, "unreachable": str(err)})
+        raise
     write_solution(path, doc)
     ch = doc["chosen"]
     forces = ", ".join(f"{k} {v:g} N" for k, v in ch["forces_n"].items())
@@ -473,7 +477,7 @@ def plot_solution_cmd(
     from ..plots.solution import plot_solution
 
     doc = read_yaml(solution, "solution file")
-    if not isinstance(doc, dict) or "chosen" not in doc:
+    if not isinstance(doc, dict) or not ("chosen" in doc or "unreachable" in doc):
         raise ArticError(f"{solution} is not a solve-target result; run 'artic solve-target' first")
     t = load_target(target)
     ctx = load_context(maps, dynamic)

@@ -31,6 +31,8 @@ def shape_gradients(points: np.ndarray) -> np.ndarray:
 
 _DN_GAUSS = shape_gradients(GAUSS)  # (8 gauss, 8 corners, 3)
 _DN_CORNER = shape_gradients(REF)
+SHAPE_GRADIENTS_GAUSS = _DN_GAUSS  # (gauss point, corner, reference axis)
+SHAPE_GRADIENTS_CORNER = _DN_CORNER  # (at corner, corner, reference axis)
 # dN as matrices for BLAS: (8 corners, 3 * G) with column l * G + g
 _D_GAUSS = _DN_GAUSS.transpose(1, 2, 0).reshape(8, -1)
 _D_CORNER = _DN_CORNER.transpose(1, 2, 0).reshape(8, -1)

@@ -24,6 +24,10 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
+
+from . import kernels
+
+USE_KERNELS = True  # compiled loops (numba) when available; the numpy path gives the same numbers
 import scipy.sparse as sp
 
 
@@ -86,6 +90,14 @@ def youngs_modulus(cyl: CylinderSet, strain: np.ndarray) -> tuple[np.ndarray, np
 
 
 def evaluate(cyl: CylinderSet, x: np.ndarray) -> CylinderState:
+    if kernels.AVAILABLE and USE_KERNELS:
+        n, length, strain, shrink, e, de, elastic = kernels.cylinder_state(
+            np.ascontiguousarray(x), cyl.i, cyl.j, cyl.l0, cyl.area0, cyl.youngs, cyl.poisson, cyl.knee, cyl.rate)
+        return CylinderState(n=n, length=length, strain=strain, elastic=elastic, shrink=shrink, e=e, de=de)
+    return evaluate_numpy(cyl, x)
+
+
+def evaluate_numpy(cyl: CylinderSet, x: np.ndarray) -> CylinderState:
     d = cyl.diff @ x
     length = np.sqrt((d * d).sum(axis=1))
     n = d / length[:, None]
@@ -105,6 +117,17 @@ def axial_stiffness(cyl: CylinderSet, cs: CylinderState) -> np.ndarray:
 def damping_frame(cyl: CylinderSet, x: np.ndarray) -> DampingFrame:
     cs = evaluate(cyl, x)
     return DampingFrame(n=cs.n, c=cyl.viscosity * cyl.area0 * cs.shrink * cs.shrink / cyl.l0)
+
+
+def nodal_forces(cyl: CylinderSet, cs: CylinderState, frame: DampingFrame | None, v: np.ndarray | None,
+                 scatter) -> np.ndarray:
+    """(N,3) nodal forces of all cylinders (elastic, plus the dashpots along ``frame`` at velocities ``v``)."""
+    if kernels.AVAILABLE and USE_KERNELS:
+        damped = frame is not None and v is not None
+        return kernels.cylinder_forces(cs.n, cs.elastic, cyl.i, cyl.j, frame.n if damped else cs.n,
+                                       frame.c if damped else cs.length, np.ascontiguousarray(v) if damped else cs.n,
+                                       cyl.n_nodes, damped)
+    return scatter @ axial_forces(cyl, cs, frame, v)
 
 
 def axial_forces(cyl: CylinderSet, cs: CylinderState, frame: DampingFrame | None, v: np.ndarray | None) -> np.ndarray:

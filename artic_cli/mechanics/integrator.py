@@ -22,12 +22,12 @@ from dataclasses import replace
 import numpy as np
 
 from ..errors import ArticError
-from . import elements
+from . import elements, kernels
 from .assembly import add_low_rank, factorize, pair_blocks
 from .contact import ContactPlanes, contact_planes, enforce
 from .model import Control, Model, State
 from .muscles import FibreState, fibre_state, fibre_stiffness, length_gradients, muscle_forces
-from ..geometry.hexahedra import corner_jacobians
+from ..geometry.hexahedra import SHAPE_GRADIENTS_CORNER, SHAPE_GRADIENTS_GAUSS
 from .volume import GUARD_FRACTION, corner_guard, volume_forces
 
 _EYE = np.eye(3)
@@ -45,15 +45,27 @@ def internal_forces(model: Model, x: np.ndarray, v: np.ndarray | None = None,
                     frame: elements.DampingFrame | None = None):
     """Forces on the nodes from cylinders, links and the volume constraint (dyn)."""
     cs = elements.evaluate(model.cyl, x)
-    f = model.scatter @ elements.axial_forces(model.cyl, cs, frame, v)
+    f = elements.nodal_forces(model.cyl, cs, frame, v, model.scatter)
     grad = vol = None
+    nt = model.n_tongue
+    if kernels.AVAILABLE and elements.USE_KERNELS and model.corner_j0 is not None:
+        kappa = model.kappa if model.volume_constraint else np.zeros_like(model.kappa)
+        fb, vol, grad, pairs, g, w = kernels.brick_terms(
+            np.ascontiguousarray(x[:nt]), model.bricks, SHAPE_GRADIENTS_GAUSS, SHAPE_GRADIENTS_CORNER, model.brick_v0, kappa,
+            model.corner_j0, model.guard_weight, GUARD_FRACTION)
+        f[:nt] += fb
+        guard = (pairs[:, 0], pairs[:, 1], g, w) if len(pairs) else None
+        if not model.volume_constraint:
+            vol = grad = None
+        return f, cs, vol, grad, guard
     if model.volume_constraint:
-        fv, vol, grad = volume_forces(x[: model.n_tongue], model.bricks, model.brick_v0, model.kappa)
-        f[: model.n_tongue] += fv
+        fv, vol, grad = volume_forces(x[:nt], model.bricks, model.brick_v0, model.kappa)
+        f[:nt] += fv
+    guard = None
     if model.corner_j0 is not None:
-        fg, _ = corner_guard(x[: model.n_tongue], model.bricks, model.corner_j0, model.guard_weight)
-        f[: model.n_tongue] += fg
-    return f, cs, vol, grad
+        fg, guard = corner_guard(x[:nt], model.bricks, model.corner_j0, model.guard_weight)
+        f[:nt] += fg
+    return f, cs, vol, grad, guard
 
 
 def guide_forces(model: Model, x: np.ndarray) -> np.ndarray:
@@ -76,14 +88,6 @@ def total_activation(model: Model, activation: np.ndarray | None) -> np.ndarray 
         return None
     act = np.zeros(len(model.muscles.names)) if activation is None else activation
     return act + model.tone if model.tone is not None else act
-
-
-def guarded_corners(model: Model, x: np.ndarray) -> tuple:
-    """(brick, corner) pairs on which the inversion guard acts."""
-    if model.corner_j0 is None:
-        return ()
-    b, c = np.nonzero(corner_jacobians(x[: model.n_tongue], model.bricks) / model.corner_j0 < GUARD_FRACTION)
-    return tuple(zip(b.tolist(), c.tolist()))
 
 
 def guide_stop(gd, x: np.ndarray) -> np.ndarray:
@@ -115,12 +119,17 @@ def tangent(model: Model, cs: elements.CylinderState, frame: elements.DampingFra
     """The banded part of the Newton matrix: mass, cylinders and links, volume, fibres' own blocks, guide."""
     # geometric stiffness T / l with its sign: compressed cylinders soften sideways (the mass term keeps
     # the matrix positive definite at these loads; a failed factorisation falls back to clipping)
-    k_geo = (cs.elastic if signed_geometry else np.maximum(cs.elastic, 0.0)) / cs.length
-    k_nn = np.maximum(elements.axial_stiffness(model.cyl, cs), 0.0) - k_geo
-    k3 = (k_nn[:, None, None] * (cs.n[:, :, None] * cs.n[:, None, :]) + k_geo[:, None, None] * _EYE
-          + (c_v * frame.c)[:, None, None] * (frame.n[:, :, None] * frame.n[:, None, :]))
+    axial = elements.axial_stiffness(model.cyl, cs)
+    if kernels.AVAILABLE and elements.USE_KERNELS:
+        blocks = kernels.cylinder_blocks(cs.n, cs.length, cs.elastic, axial, frame.n, frame.c, c_v, signed_geometry)
+    else:
+        k_geo = (cs.elastic if signed_geometry else np.maximum(cs.elastic, 0.0)) / cs.length
+        k_nn = np.maximum(axial, 0.0) - k_geo
+        k3 = (k_nn[:, None, None] * (cs.n[:, :, None] * cs.n[:, None, :]) + k_geo[:, None, None] * _EYE
+              + (c_v * frame.c)[:, None, None] * (frame.n[:, :, None] * frame.n[:, None, :]))
+        blocks = pair_blocks(k3)
     idx = [model.cyl_index]
-    val = [pair_blocks(k3)]
+    val = [blocks]
     if grad is not None:
         g = grad.reshape(len(model.brick_v0), 24)
         w = model.kappa / model.brick_v0
@@ -144,7 +153,7 @@ def tangent(model: Model, cs: elements.CylinderState, frame: elements.DampingFra
 
 
 def rank_one_terms(model: Model, x: np.ndarray, fs: FibreState | None, act: np.ndarray | None, h: float,
-                   planes: ContactPlanes | None, active: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+                   planes: ContactPlanes | None, active: np.ndarray, guard=None) -> tuple[np.ndarray, np.ndarray]:
     """Newton terms k v v^T that change often or do not fit the band: (V (3N, r), k (r,)).
 
     Stiff fibres (along their whole length), active wall contacts (with the reaction on the mandible)
@@ -168,14 +177,12 @@ def rank_one_terms(model: Model, x: np.ndarray, fs: FibreState | None, act: np.n
             v[planes.jaw_nodes, :, c] -= n[c] / len(planes.jaw_nodes)
         cols.append(v.reshape(n3, -1))
         ks.append(np.full(len(nodes), model.contact.stiffness))
-    if model.corner_j0 is not None:
-        _, guard = corner_guard(x[: model.n_tongue], model.bricks, model.corner_j0, model.guard_weight)
-        if guard is not None:
-            b, _, g, w = guard
-            v = np.zeros((model.n_nodes, 3, len(b)))
-            np.add.at(v, (model.bricks[b], slice(None), np.arange(len(b))[:, None]), g)
-            cols.append(v.reshape(n3, -1))
-            ks.append(w)
+    if guard is not None:  # corners near inversion (from internal_forces)
+        b, _, g, w = guard
+        v = np.zeros((model.n_nodes, 3, len(b)))
+        np.add.at(v, (model.bricks[b], slice(None), np.arange(len(b))[:, None]), g)
+        cols.append(v.reshape(n3, -1))
+        ks.append(w)
     stop = guide_stop(model.guide, x)
     if stop.any():
         gd = model.guide
@@ -261,7 +268,7 @@ def _step_once(model: Model, state: State, control: Control, h: float) -> State:
     for it in range(1, opt.max_iter + 1):
         a = c_a * x + a_known
         v = c_v * x + v_known
-        f_int, cs, _, grad = internal_forces(model, x, v, frame)
+        f_int, cs, _, grad, guard = internal_forces(model, x, v, frame)
         f = f_int + guide_forces(model, x)
         if ms is not None:
             fs = fibre_state(ms, x, act, state.sigma2, state.fibre_strain, h)
@@ -269,7 +276,7 @@ def _step_once(model: Model, state: State, control: Control, h: float) -> State:
         fc, active, _ = contact_forces(model, x, planes)
         f += fc
         active_key = (None if planes is None else tuple(planes.nodes[active]), tuple(guide_stop(model.guide, x)),
-                      guarded_corners(model, x))
+                      () if guard is None else tuple(zip(guard[0].tolist(), guard[1].tolist())))
         if factor is not None and active_key != factor.terms_key:
             factor = None  # contact set changed: keep the band, redo the small Woodbury part
         resid = (model.mass @ a - f - f_ext).ravel()[free]
@@ -281,7 +288,7 @@ def _step_once(model: Model, state: State, control: Control, h: float) -> State:
                     except np.linalg.LinAlgError:
                         base = factorize(tangent(model, cs, frame, grad, fs, act, h, c_a, c_v, False), key)
                     refactors += 1
-                vecs, ks = rank_one_terms(model, x, fs, act, h, planes, active)
+                vecs, ks = rank_one_terms(model, x, fs, act, h, planes, active, guard)
                 factor = add_low_rank(base, vecs[free], ks, active_key)
             except np.linalg.LinAlgError:
                 raise SimulationDiverged(f"the tissue lost stability at t = {state.t * 1e3:.1f} ms (tangent not "

@@ -11,6 +11,8 @@ from .common import save_figure
 
 
 def plot_solution(doc: dict, target, jm, path: Path | str) -> Path:
+    if "unreachable" in doc:
+        return _plot_unreachable(doc, target, jm, path)
     fig, axes = plt.subplots(1, 2, figsize=(12, 5.5))
     chosen = doc["chosen"]
     muscles = list(dict.fromkeys([m for c in doc["candidates"][:1] for m in c["forces_n"]]))
@@ -46,4 +48,22 @@ def plot_solution(doc: dict, target, jm, path: Path | str) -> Path:
     forces = ", ".join(f"{k} {v:g} N" for k, v in doc.get("refined", chosen)["forces_n"].items())
     fig.suptitle(f"{doc['target']}: {chosen['family']} {chosen['map']} -> {forces} "
                  f"(numbers: the {len(doc['candidates'])} cheapest candidates)", fontsize=10)
+    return save_figure(fig, path)
+
+
+def _plot_unreachable(doc: dict, target, jm, path: Path | str) -> Path:
+    """The target against every EP vector of the jaw position: where it lies outside the mapped region."""
+    c = ("tip", "dorsum").index(target.crucial.point)
+    fig, ax = plt.subplots(figsize=(6.5, 5.5))
+    ax.plot(*jm.rest[c, :2], "ko", ms=5, label="rest")
+    for m, net in jm.single.items():
+        xy = net.x[:, c, :2]
+        ax.plot(xy[:, 0], xy[:, 1], "-", lw=1, label=m)
+    ax.plot(*target.crucial.at_cm, "*", ms=14, color="#e67e22", label="crucial target (unreachable)")
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (cm), anterior +")
+    ax.set_ylabel("y (cm), superior +")
+    ax.grid(alpha=0.25)
+    ax.legend(fontsize=7)
+    ax.set_title(doc["unreachable"][:110] + ("..." if len(doc["unreachable"]) > 110 else ""), fontsize=7)
     return save_figure(fig, path)

@@ -1,0 +1,191 @@
+"""Compiled inner loops (numba) for the two hottest pieces of a time step.
+
+Both compute exactly what the numpy code in :mod:`.elements` computes (a test compares them); they fuse the
+dozens of array passes over the ~2200 cylinders into one loop each.  Without numba the numpy path runs.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+try:  # pragma: no cover - exercised whenever numba is installed (a dependency)
+    from numba import njit
+
+    AVAILABLE = True
+except ImportError:  # pragma: no cover
+    AVAILABLE = False
+
+    def njit(*args, **kwargs):
+        def wrap(fn):
+            return fn
+        return wrap(args[0]) if args and callable(args[0]) else wrap
+
+
+@njit(cache=True, fastmath=False)
+def cylinder_state(x, ci, cj, l0, area0, youngs, poisson, knee, rate):
+    """Per cylinder: unit axis n (C,3), length, strain, shrink, E, dE/de, elastic tension."""
+    c = len(ci)
+    n = np.empty((c, 3))
+    length = np.empty(c)
+    strain = np.empty(c)
+    shrink = np.empty(c)
+    e = np.empty(c)
+    de = np.empty(c)
+    elastic = np.empty(c)
+    for k in range(c):
+        a, b = ci[k], cj[k]
+        d0 = x[b, 0] - x[a, 0]
+        d1 = x[b, 1] - x[a, 1]
+        d2 = x[b, 2] - x[a, 2]
+        ln = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        length[k] = ln
+        n[k, 0] = d0 / ln
+        n[k, 1] = d1 / ln
+        n[k, 2] = d2 / ln
+        s = ln / l0[k] - 1.0
+        strain[k] = s
+        sh = 1.0 - poisson[k] * s
+        if sh < 0.05:
+            sh = 0.05
+        shrink[k] = sh
+        over = s - knee[k]
+        if over > 0.0:
+            g = min(rate[k] * over, 50.0)
+            ek = youngs[k] * np.exp(g)
+            e[k] = ek
+            de[k] = rate[k] * ek
+        else:
+            e[k] = youngs[k]
+            de[k] = 0.0
+        elastic[k] = e[k] * s * area0[k] * sh * sh
+    return n, length, strain, shrink, e, de, elastic
+
+
+@njit(cache=True, fastmath=False)
+def cylinder_forces(n, elastic, ci, cj, frame_n, frame_c, v, n_nodes, with_damping):
+    """Nodal forces (N,3) of the cylinders: elastic tension along n, dashpot along the step's frame."""
+    f = np.zeros((n_nodes, 3))
+    for k in range(len(ci)):
+        a, b = ci[k], cj[k]
+        t = elastic[k]
+        g0 = t * n[k, 0]
+        g1 = t * n[k, 1]
+        g2 = t * n[k, 2]
+        if with_damping:
+            r = (frame_n[k, 0] * (v[b, 0] - v[a, 0]) + frame_n[k, 1] * (v[b, 1] - v[a, 1])
+                 + frame_n[k, 2] * (v[b, 2] - v[a, 2])) * frame_c[k]
+            g0 += r * frame_n[k, 0]
+            g1 += r * frame_n[k, 1]
+            g2 += r * frame_n[k, 2]
+        f[a, 0] += g0
+        f[a, 1] += g1
+        f[a, 2] += g2
+        f[b, 0] -= g0
+        f[b, 1] -= g1
+        f[b, 2] -= g2
+    return f
+
+
+@njit(cache=True, fastmath=False)
+def cylinder_blocks(n, length, elastic, axial, frame_n, frame_c, c_v, signed):
+    """(C,6,6) tangent blocks [[k, -k], [-k, k]] with k = (K_ax - T/l) n n^T + T/l I + c_v c n0 n0^T."""
+    c = len(length)
+    out = np.empty((c, 6, 6))
+    for k in range(c):
+        t = elastic[k] if signed else max(elastic[k], 0.0)
+        kg = t / length[k]
+        kn = max(axial[k], 0.0) - kg
+        cv = c_v * frame_c[k]
+        for p in range(3):
+            for q in range(3):
+                val = kn * n[k, p] * n[k, q] + cv * frame_n[k, p] * frame_n[k, q]
+                if p == q:
+                    val += kg
+                out[k, p, q] = val
+                out[k, p + 3, q + 3] = val
+                out[k, p, q + 3] = -val
+                out[k, p + 3, q] = -val
+    return out
+
+
+@njit(cache=True, fastmath=False)
+def brick_terms(x, bricks, dn_gauss, dn_corner, v0, kappa, j0, guard_w, fraction):
+    """Volume penalty and inversion guard of every brick in one pass.
+
+    Returns forces (N,3), volumes (B,), dV/dx (B,8,3), the guarded (brick, corner) pairs (K,2), their
+    d(J/J0)/dx (K,8,3) and weights (K,).  Same formulas as :mod:`.volume` and :mod:`..geometry.hexahedra`.
+    """
+    nb = bricks.shape[0]
+    f = np.zeros_like(x)
+    vol = np.zeros(nb)
+    grad = np.zeros((nb, 8, 3))
+    gk = []
+    gg = []
+    gw = []
+    jac = np.empty((3, 3))
+    cof = np.empty((3, 3))
+    for b in range(nb):
+        for g in range(dn_gauss.shape[0]):
+            for i in range(3):
+                for l in range(3):
+                    acc = 0.0
+                    for a in range(8):
+                        acc += x[bricks[b, a], i] * dn_gauss[g, a, l]
+                    jac[l, i] = acc  # column l of the Jacobian, component i
+            # cofactors: d det / d column l = cross of the other two columns
+            for i in range(3):
+                i1, i2 = (i + 1) % 3, (i + 2) % 3
+                cof[0, i] = jac[1, i1] * jac[2, i2] - jac[1, i2] * jac[2, i1]
+                cof[1, i] = jac[2, i1] * jac[0, i2] - jac[2, i2] * jac[0, i1]
+                cof[2, i] = jac[0, i1] * jac[1, i2] - jac[0, i2] * jac[1, i1]
+            det = jac[0, 0] * cof[0, 0] + jac[0, 1] * cof[0, 1] + jac[0, 2] * cof[0, 2]
+            vol[b] += det
+            for a in range(8):
+                for i in range(3):
+                    grad[b, a, i] += (cof[0, i] * dn_gauss[g, a, 0] + cof[1, i] * dn_gauss[g, a, 1]
+                                      + cof[2, i] * dn_gauss[g, a, 2])
+        scale = -kappa[b] * (vol[b] - v0[b]) / v0[b]
+        if scale != 0.0:
+            for a in range(8):
+                for i in range(3):
+                    f[bricks[b, a], i] += scale * grad[b, a, i]
+        if guard_w.shape[0] == 0:
+            continue
+        for c in range(8):
+            for i in range(3):
+                for l in range(3):
+                    acc = 0.0
+                    for a in range(8):
+                        acc += x[bricks[b, a], i] * dn_corner[c, a, l]
+                    jac[l, i] = acc
+            for i in range(3):
+                i1, i2 = (i + 1) % 3, (i + 2) % 3
+                cof[0, i] = jac[1, i1] * jac[2, i2] - jac[1, i2] * jac[2, i1]
+                cof[1, i] = jac[2, i1] * jac[0, i2] - jac[2, i2] * jac[0, i1]
+                cof[2, i] = jac[0, i1] * jac[1, i2] - jac[0, i2] * jac[1, i1]
+            det = jac[0, 0] * cof[0, 0] + jac[0, 1] * cof[0, 1] + jac[0, 2] * cof[0, 2]
+            ratio = det / j0[b, c]
+            if ratio < fraction:
+                gc = np.empty((8, 3))
+                for a in range(8):
+                    for i in range(3):
+                        gc[a, i] = (cof[0, i] * dn_corner[c, a, 0] + cof[1, i] * dn_corner[c, a, 1]
+                                    + cof[2, i] * dn_corner[c, a, 2]) / j0[b, c]
+                w = guard_w[b]
+                push = w * (fraction - ratio)
+                for a in range(8):
+                    for i in range(3):
+                        f[bricks[b, a], i] += push * gc[a, i]
+                gk.append((b, c))
+                gg.append(gc)
+                gw.append(w)
+    k = len(gk)
+    pairs = np.empty((k, 2), dtype=np.int64)
+    gout = np.empty((k, 8, 3))
+    wout = np.empty(k)
+    for m in range(k):
+        pairs[m, 0] = gk[m][0]
+        pairs[m, 1] = gk[m][1]
+        gout[m] = gg[m]
+        wout[m] = gw[m]
+    return f, vol, grad, pairs, gout, wout

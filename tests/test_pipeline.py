@@ -1,0 +1,78 @@
+"""The whole `make paper` pipeline on a CI-sized config: every artefact opens, every report row is computed,
+every figure is a real PNG; a second `make paper` does nothing; a missing config stops the first stage."""
+
+from __future__ import annotations
+
+import re
+import shutil
+import subprocess
+
+import h5py
+import pytest
+
+from conftest import ROOT
+
+VENV = ROOT / ".venv"
+pytestmark = pytest.mark.skipif(not (VENV / ".installed").exists() or shutil.which("make") is None,
+                                reason="needs `make setup` (the pipeline runs the installed artic)")
+
+
+def make(*args, timeout=1200):
+    return subprocess.run(["make", "--no-print-directory", *args], cwd=ROOT, capture_output=True, text=True,
+                          timeout=timeout)
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory):
+    out = tmp_path_factory.mktemp("pipeline")
+    res = make("paper", "CONFIG=configs/ci_thin.yaml", f"OUT={out}")
+    assert res.returncode == 0, res.stdout[-3000:] + res.stderr[-3000:]
+    return out
+
+
+def test_every_artefact_opens(built):
+    kinds = {"mesh.h5": "mesh", "epmaps.h5": "epmap", "dynamic.h5": "dynamic-map",
+             "muscle_function.h5": "muscle-function"}
+    for name, kind in kinds.items():
+        with h5py.File(built / name, "r") as f:
+            assert f.attrs["kind"] == kind
+    sims = sorted((built / "sims").glob("*.h5"))
+    assert len(sims) == 7
+    for s in sims:
+        with h5py.File(s, "r") as f:
+            assert f.attrs["kind"] == "simulation" and f["nodes/positions"].shape[0] > 1
+    assert len(list((built / "experiments").glob("*.json"))) == 6
+    assert len(list((built / "solutions").glob("*.yaml"))) == 3
+
+
+def test_every_report_row_has_a_computed_value(built):
+    text = (built / "reports" / "paper.md").read_text()
+    rows = [ln for ln in text.splitlines() if ln.startswith("| ") and not ln.startswith("| item")]
+    assert len(rows) >= 60
+    for row in rows:
+        cells = [c.strip() for c in row.strip("|").split("|")]
+        assert len(cells) == 4, row
+        ours, verdict = cells[2], cells[3]
+        assert ours and ours.lower() not in ("nan", "none", "n/a"), row
+        assert re.match(r"(agrees|differs) \(", verdict), row
+
+
+def test_every_figure_is_a_real_png(built):
+    text = (built / "reports" / "paper.md").read_text()
+    figures = re.findall(r"\]\(([\w.-]+\.png)\)", text)
+    assert len(figures) >= 12
+    for name in figures:
+        data = (built / "reports" / name).read_bytes()
+        assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 20_000, name
+
+
+def test_a_second_run_does_nothing(built):
+    res = make("paper", "CONFIG=configs/ci_thin.yaml", f"OUT={built}", "--question")
+    assert res.returncode == 0, res.stdout + res.stderr  # -q: everything is up to date
+
+
+def test_a_missing_config_stops_the_first_stage(tmp_path):
+    res = make("paper", "CONFIG=configs/missing.yaml", f"OUT={tmp_path}")
+    assert res.returncode != 0
+    assert "config not found: configs/missing.yaml" in res.stderr
+    assert not (tmp_path / "mesh.h5").exists() and not (tmp_path / "reports" / "paper.md").exists()
