@@ -9,6 +9,7 @@ OUT      ?= data
 OUT      := $(patsubst %/,%,$(OUT))
 REPORT   ?= $(if $(filter data,$(OUT)),reports,$(OUT)/reports)
 PIPELINE ?= pipelines/paper.yaml
+FIG9_JAW ?= JO_2.5
 
 PY     := $(VENV)/bin/python
 ARTIC  := $(VENV)/bin/artic
@@ -86,6 +87,7 @@ $(OUT)/epmaps.h5: $(OUT)/mesh.h5 $(CONFIG) $(SRC)
 dynamic: $(OUT)/dynamic.h5
 $(OUT)/dynamic.h5: $(OUT)/epmaps.h5
 	$(ARTIC) dynamic-map --maps $< --out $@
+	$(ARTIC) plot dynamic-map --maps $< --dynamic $@ --jaw $(FIG9_JAW) --out $(REPORT)/fig9_dynamic_map.png
 
 SOLUTIONS := $(TARGET_NAMES:%=$(OUT)/solutions/%.yaml)
 solve: $(SOLUTIONS)

@@ -221,7 +221,8 @@ def map_rows(data: Path) -> tuple[list[Row], list[str]]:
                         ("" if r["loo_tip_cm"] is None else
                          f" (leave-one-out {r['loo_tip_cm']:.3f} / {r['loo_dorsum_cm']:.3f})"),
                         _verdict(worst <= goal, f"goal <= {goal:g} cm {'near the typical jaw' if near else ''}")))
-    lines = ["![EP vectors and contour nets (Fig. 8)](fig8_epmap.png)", ""]
+    lines = ["![EP vectors and contour nets (Fig. 8)](fig8_epmap.png)",
+             "![A jaw position's map, simulated and derived (Fig. 9)](fig9_dynamic_map.png)", ""]
     sols = sorted((data / "solutions").glob("*.yaml")) if (data / "solutions").is_dir() else []
     import yaml
 

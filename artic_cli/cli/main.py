@@ -281,14 +281,14 @@ def muscle_function_cmd(
     try:
         if bar is not None:
             with bar:
-                mf, wall, cached = build_muscle_function(mesh, config, out, jobs, cache, update)
+                mf, wall, cached, distinct = build_muscle_function(mesh, config, out, jobs, cache, update)
         else:
-            mf, wall, cached = build_muscle_function(mesh, config, out, jobs, cache, update)
+            mf, wall, cached, distinct = build_muscle_function(mesh, config, out, jobs, cache, update)
     except KeyboardInterrupt:
         err_console.print(f"interrupted; {out} was not touched, finished starts are cached and a rerun resumes")
         raise typer.Exit(130) from None
-    out_console.print(f"wrote {out}: {len(mf.starts)} starts x {len(mf.muscles)} muscles ({cached} starts from the "
-                      f"cache) in {wall:.1f} s", highlight=False)
+    out_console.print(f"wrote {out}: {len(mf.starts)} starts ({distinct} distinct force sets, {cached} from the "
+                      f"cache) x {len(mf.muscles)} muscles in {wall:.1f} s", highlight=False)
     table = Table(title=f"Where each muscle drives the control points ({mf.drive_n:g} N, {mf.drive_ms:g} ms)")
     for col in ("muscle", "point", "start spread cm", "end spread cm", "mean end - rest, x / y cm"):
         table.add_column(col, justify="left" if col in ("muscle", "point") else "right")
@@ -460,6 +460,24 @@ def plot_ep_map_cmd(
     m = load_ep_maps(maps)
     path = plot_ep_map(m, jaw, pair, out)
     out_console.print(f"wrote {path}", highlight=False)
+
+
+@plot_app.command("dynamic-map")
+@handle_errors
+def plot_dynamic_map_cmd(
+    maps: Path = typer.Option(Path("data/epmaps.h5"), "--maps", help="EP maps."),
+    dynamic: Path = typer.Option(Path("data/dynamic.h5"), "--dynamic", help="Dynamic map."),
+    jaw: str = typer.Option("JO_2.5", "--jaw", help="Jaw position to compare (the paper's Fig. 9: JO 2.5 N)."),
+    out: Path = typer.Option(Path("reports/fig9_dynamic_map.png"), "--out", help="Picture to write (PNG)."),
+):
+    """Fig. 9: a jaw position's EP vectors, simulated and derived from the typical map."""
+    from ..control.dynamic import load_dynamic_map
+    from ..control.epmap import load_ep_maps
+    from ..plots.dynamic import plot_dynamic_map
+
+    m = load_ep_maps(maps)
+    dm = load_dynamic_map(dynamic, maps_path=maps)
+    out_console.print(f"wrote {plot_dynamic_map(m, dm, jaw, out)}", highlight=False)
 
 
 @plot_app.command("solution")

@@ -7,8 +7,9 @@ and one muscle pulls at 4 N for 150 ms; the end points of the tip and the
 dorsum show where each muscle drives them whatever the start.  As in the
 paper the wall is left out (``muscle_function.contact``).
 
-Each start is one task (its 120-ms run and the ten 150-ms drives), run in
-parallel through joblib and cached on disk like the EP maps, so an
+Each distinct start force set is one task (its 120-ms run and the ten 150-ms
+drives; the combinations share muscles, so 864 starts are 726 distinct ones),
+run in parallel through joblib and cached on disk like the EP maps, so an
 interrupted run resumes.
 """
 
@@ -26,7 +27,7 @@ import numpy as np
 
 from .. import units
 from ..config import Config, load_config, model_hash, parse_config
-from ..control.epmap import _backend, control_for, physics_code_hash, watch_nodes
+from ..control.epmap import _backend, canonical, control_for, physics_code_hash, watch_nodes
 from ..errors import ArticError
 from ..io.store import atomic_h5, file_hash, load_mesh, open_artifact
 from ..mechanics.model import Model, build_articulator
@@ -51,12 +52,12 @@ def starts(cfg: Config) -> list[tuple[int, tuple[float, ...]]]:
             for lv in itertools.product(spec.start_levels_n, repeat=len(spec.start_combinations[c]))]
 
 
-def run_start(key: str, combo: tuple[str, ...], levels: tuple[float, ...], start_ms: float,
-              muscles: tuple[str, ...], drive_n: float, drive_ms: float, cfg_json: str, mesh_path: str) -> dict:
-    """One start and every muscle's drive from it: control points (cm)."""
+def run_start(key: str, start_forces: tuple, start_ms: float, muscles: tuple[str, ...], drive_n: float,
+              drive_ms: float, cfg_json: str, mesh_path: str) -> dict:
+    """One start (``start_forces``: canonical (muscle, N) pairs) and every muscle's drive from it (cm)."""
     model, rest = _model(key, cfg_json, mesh_path)
     watch = watch_nodes(model)
-    forces = {m: f for m, f in zip(combo, levels) if f > 0}
+    forces = dict(start_forces)
     h = hold(model, rest, control_for(model, forces), units.ms_to_s(start_ms), watch, units.ms_to_s(start_ms))
     start = h.state
     ends = []
@@ -105,8 +106,11 @@ def build_muscle_function(mesh: Path | str = "data/mesh.h5", config: Path | str 
     memory = Memory(Path(cache) if cache is not None else out.parent / "cache", verbose=0)
     fn = memory.cache(run_start, ignore=["cfg_json", "mesh_path"])
     todo = starts(cfg)
-    calls = [(key, tuple(spec.start_combinations[c]), lv, spec.start_ms, tuple(spec.muscles), spec.drive_force_n,
-              spec.drive_ms, cfg_json, str(mesh)) for c, lv in todo]
+    # combinations share muscles: a start whose other muscles are at zero recurs; each distinct one runs once
+    keys = [canonical(dict(zip(spec.start_combinations[c], lv))) for c, lv in todo]
+    unique = list(dict.fromkeys(keys))
+    calls = [(key, forces, spec.start_ms, tuple(spec.muscles), spec.drive_force_n, spec.drive_ms, cfg_json,
+              str(mesh)) for forces in unique]
     cached = sum(fn.check_call_in_cache(*a) for a in calls)
     results = [None] * len(calls)
     t0 = time.perf_counter()
@@ -117,6 +121,8 @@ def build_muscle_function(mesh: Path | str = "data/mesh.h5", config: Path | str 
             if progress is not None:
                 progress(n, len(calls))
     wall = time.perf_counter() - t0
+    where = {forces: i for i, forces in enumerate(unique)}
+    results = [results[where[k]] for k in keys]
     model, rest = _model(key, cfg_json, str(mesh))
     mf = MuscleFunction(muscles=list(spec.muscles), combinations=[list(c) for c in spec.start_combinations],
                         combo=np.array([c for c, _ in todo]),
@@ -134,7 +140,7 @@ def build_muscle_function(mesh: Path | str = "data/mesh.h5", config: Path | str 
                                  ("start_forces", mf.start_forces, "N"), ("starts", mf.starts, "cm"),
                                  ("ends", mf.ends, "cm"), ("rest", mf.rest, "cm")):
             f.create_dataset(name, data=data).attrs["units"] = unit
-    return mf, wall, cached
+    return mf, wall, cached, len(unique)
 
 
 def _indexed(i, fn, args):
