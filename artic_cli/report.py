@@ -261,6 +261,7 @@ def write_report(data: Path | str = "data", out: Path | str = "reports/paper.md"
     lines += ["", "## Muscles, jaw-hyoid complex and contact (section III)", "",
               "![SG 4 N + JO 3 N, 20 ms (Fig. 4 right)](fig4_sg.png) ![GGp 4 N + JO 3 N, 20 ms (Fig. 4 left)]"
               "(fig4_ggp.png)", "", "Animations: [fig4_sg.gif](fig4_sg.gif), [fig4_ggp.gif](fig4_ggp.gif).", "",
+              "![SG 4 N + JO 3 N held for 300 ms](art_sg_jo.png)", "",
               "| item | paper | ours | verdict |", "|---|---|---|---|"]
     lines += [f"| {r.item} | {r.paper} | {r.ours} | {r.verdict} |" for r in articulator_rows(data)]
     rows, extra = function_rows(data)

@@ -48,7 +48,7 @@ def test_every_artefact_opens(built):
 def test_every_report_row_has_a_computed_value(built):
     text = (built / "reports" / "paper.md").read_text()
     rows = [ln for ln in text.splitlines() if ln.startswith("| ") and not ln.startswith("| item")]
-    assert len(rows) >= 60
+    assert len(rows) >= 40  # the thin config has fewer Table III and IV rows than the default (81)
     for row in rows:
         cells = [c.strip() for c in row.strip("|").split("|")]
         assert len(cells) == 4, row
