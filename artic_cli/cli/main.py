@@ -45,6 +45,24 @@ def handle_errors(fn):
     return wrapper
 
 
+def _with_progress(label: str, work, plain: bool = False):
+    """Run ``work(update)`` under a progress bar (terminal) or progress lines (``plain``, for logs)."""
+    bar, update = _progress(label, plain)
+    if bar is None:
+        return work(update)
+    with bar:
+        return work(update)
+
+
+def _print_table(title: str, columns: tuple[str, ...], rows, left: tuple[str, ...] = ()) -> None:
+    table = Table(title=title)
+    for col in columns:
+        table.add_column(col, justify="left" if col in left else "right")
+    for r in rows:
+        table.add_row(*r)
+    out_console.print(table)
+
+
 def _progress(label: str, plain: bool = False):
     """A rich progress bar (done/total, ETA) when stderr is a terminal, else None; with ``plain``, lines at
     every tenth of the work instead (for logs)."""
@@ -112,13 +130,9 @@ def simulate_cmd(
     """Move the model under a schedule of muscle forces and loads; write trajectories."""
     from ..stages import simulate
 
-    bar, update = _progress("simulating")
     args = (schedule, duration, dt, mesh, config, out, volume_constraint, plot)
-    if bar is not None:
-        with bar:
-            r = simulate(*args, update, tongue_only=tongue_only, contact=contact, animate=animate)
-    else:
-        r = simulate(*args, tongue_only=tongue_only, contact=contact, animate=animate)
+    r = _with_progress("simulating", lambda update: simulate(*args, update, tongue_only=tongue_only, contact=contact,
+                                                             animate=animate))
     t = r.trajectory
     sim_time = t.time[-1] - t.time[0]
     out_console.print(
@@ -196,13 +210,9 @@ def experiment_cmd(
     if as_json:
         out_console.print_json(json.dumps(rows_as_dicts(rows)))
         return
-    table = Table(title=f"experiment {name}: ours beside Dang & Honda (2004)")
-    for col in ("quantity", "ours", "paper", "unit", "note"):
-        table.add_column(col, justify="left" if col in ("quantity", "note") else "right")
-    for r in rows:
-        table.add_row(r.name, "n/a" if r.ours is None else f"{r.ours:.3g}", "" if r.paper is None else f"{r.paper:g}",
-                      r.unit, r.note)
-    out_console.print(table)
+    _print_table(f"experiment {name}: ours beside Dang & Honda (2004)", ("quantity", "ours", "paper", "unit", "note"),
+                 [(r.name, "n/a" if r.ours is None else f"{r.ours:.3g}", "" if r.paper is None else f"{r.paper:g}",
+                   r.unit, r.note) for r in rows], left=("quantity", "note"))
 
 
 @app.command("ep-map")
@@ -227,13 +237,9 @@ def ep_map_cmd(
     from ..control.epmap import build_ep_maps
     from ..experiments.paper import PAPER_CONTRIBUTION
 
-    bar, update = _progress("equilibria", plain=True)
     try:
-        if bar is not None:
-            with bar:
-                r = build_ep_maps(mesh, config, out, jobs, backend, scheduler, fast, cache, update, force)
-        else:
-            r = build_ep_maps(mesh, config, out, jobs, backend, scheduler, fast, cache, update, force)
+        r = _with_progress("equilibria", lambda update: build_ep_maps(mesh, config, out, jobs, backend, scheduler, fast,
+                                                                      cache, update, force), plain=True)
     except KeyboardInterrupt:
         err_console.print(f"interrupted; {out} was not touched, finished equilibria are cached and a rerun "
                           "resumes from them")
@@ -252,15 +258,15 @@ def ep_map_cmd(
     if r.not_monotonic:
         out_console.print("[yellow]EP vectors not monotonic:[/] " + "; ".join(r.not_monotonic), highlight=False)
     c = r.contribution
-    table = Table(title=f"Contribution factors (Table III), jaw position '{c['jaw']}'")
-    for col in ("muscle", "tip", "paper tip", "dorsum", "paper dorsum", "tip amplitude cm", "dorsum amplitude cm"):
-        table.add_column(col, justify="left" if col == "muscle" else "right")
+    rows = []
     for m, (ft, fd) in c["factor"].items():
         pt, pd = PAPER_CONTRIBUTION.get(m, (None, None))
         at, ad = c["amplitude_cm"][m]
-        table.add_row(m, f"{ft:.2f}", "" if pt is None else f"{pt:.2f}", f"{fd:.2f}", "" if pd is None else f"{pd:.2f}",
-                      f"{at:.3f}", f"{ad:.3f}")
-    out_console.print(table)
+        rows.append((m, f"{ft:.2f}", "" if pt is None else f"{pt:.2f}", f"{fd:.2f}",
+                     "" if pd is None else f"{pd:.2f}", f"{at:.3f}", f"{ad:.3f}"))
+    _print_table(f"Contribution factors (Table III), jaw position '{c['jaw']}'",
+                 ("muscle", "tip", "paper tip", "dorsum", "paper dorsum", "tip amplitude cm", "dorsum amplitude cm"),
+                 rows, left=("muscle",))
 
 
 @app.command("muscle-function")
@@ -277,13 +283,9 @@ def muscle_function_cmd(
     """Section IV.A.1: each muscle at 4 N for 150 ms from scattered starts (Figs. 5 and 6)."""
     from ..experiments.muscle_function import build_muscle_function, convergence
 
-    bar, update = _progress("starts", plain=True)
     try:
-        if bar is not None:
-            with bar:
-                mf, wall, cached, distinct = build_muscle_function(mesh, config, out, jobs, cache, update)
-        else:
-            mf, wall, cached, distinct = build_muscle_function(mesh, config, out, jobs, cache, update)
+        mf, wall, cached, distinct = _with_progress(
+            "starts", lambda update: build_muscle_function(mesh, config, out, jobs, cache, update), plain=True)
     except KeyboardInterrupt:
         err_console.print(f"interrupted; {out} was not touched, finished starts are cached and a rerun resumes")
         raise typer.Exit(130) from None
@@ -361,13 +363,9 @@ def solve_target_cmd(
     ctx = load_context(maps, dynamic, mesh if (verify or refine) else None)
     if batch is not None:
         targets = read_batch(batch)
-        bar, update = _progress("targets", plain=True)
         args = (str(mesh), None if config is None else str(config))
-        if bar is not None:
-            with bar:
-                res = solve_batch(ctx, targets, jobs, args, verify, refine, budget, update)
-        else:
-            res = solve_batch(ctx, targets, jobs, args, verify, refine, budget, update)
+        res = _with_progress("targets", lambda update: solve_batch(ctx, targets, jobs, args, verify, refine, budget,
+                                                                   update), plain=True)
         path = out or Path("data/solutions") / f"{batch.stem}.csv"
         write_text_atomic(path, batch_csv(res))
         bad = sum("unreachable" in r for r in res)

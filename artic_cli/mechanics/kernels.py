@@ -109,6 +109,24 @@ def cylinder_blocks(n, length, elastic, axial, frame_n, frame_c, c_v, signed):
 
 
 @njit(cache=True, fastmath=False)
+def _jacobian_det(x, nodes, dn, jac, cof):
+    """det of the brick's Jacobian at one reference point (shape gradients ``dn`` (8,3)); fills ``jac`` (its
+    columns, jac[l, i]) and ``cof`` (d det / d column l = cross of the other two columns)."""
+    for i in range(3):
+        for l in range(3):
+            acc = 0.0
+            for a in range(8):
+                acc += x[nodes[a], i] * dn[a, l]
+            jac[l, i] = acc
+    for i in range(3):
+        i1, i2 = (i + 1) % 3, (i + 2) % 3
+        cof[0, i] = jac[1, i1] * jac[2, i2] - jac[1, i2] * jac[2, i1]
+        cof[1, i] = jac[2, i1] * jac[0, i2] - jac[2, i2] * jac[0, i1]
+        cof[2, i] = jac[0, i1] * jac[1, i2] - jac[0, i2] * jac[1, i1]
+    return jac[0, 0] * cof[0, 0] + jac[0, 1] * cof[0, 1] + jac[0, 2] * cof[0, 2]
+
+
+@njit(cache=True, fastmath=False)
 def brick_terms(x, bricks, dn_gauss, dn_corner, v0, kappa, j0, guard_w, fraction):
     """Volume penalty and inversion guard of every brick in one pass.
 
@@ -126,19 +144,7 @@ def brick_terms(x, bricks, dn_gauss, dn_corner, v0, kappa, j0, guard_w, fraction
     cof = np.empty((3, 3))
     for b in range(nb):
         for g in range(dn_gauss.shape[0]):
-            for i in range(3):
-                for l in range(3):
-                    acc = 0.0
-                    for a in range(8):
-                        acc += x[bricks[b, a], i] * dn_gauss[g, a, l]
-                    jac[l, i] = acc  # column l of the Jacobian, component i
-            # cofactors: d det / d column l = cross of the other two columns
-            for i in range(3):
-                i1, i2 = (i + 1) % 3, (i + 2) % 3
-                cof[0, i] = jac[1, i1] * jac[2, i2] - jac[1, i2] * jac[2, i1]
-                cof[1, i] = jac[2, i1] * jac[0, i2] - jac[2, i2] * jac[0, i1]
-                cof[2, i] = jac[0, i1] * jac[1, i2] - jac[0, i2] * jac[1, i1]
-            det = jac[0, 0] * cof[0, 0] + jac[0, 1] * cof[0, 1] + jac[0, 2] * cof[0, 2]
+            det = _jacobian_det(x, bricks[b], dn_gauss[g], jac, cof)
             vol[b] += det
             for a in range(8):
                 for i in range(3):
@@ -152,18 +158,7 @@ def brick_terms(x, bricks, dn_gauss, dn_corner, v0, kappa, j0, guard_w, fraction
         if guard_w.shape[0] == 0:
             continue
         for c in range(8):
-            for i in range(3):
-                for l in range(3):
-                    acc = 0.0
-                    for a in range(8):
-                        acc += x[bricks[b, a], i] * dn_corner[c, a, l]
-                    jac[l, i] = acc
-            for i in range(3):
-                i1, i2 = (i + 1) % 3, (i + 2) % 3
-                cof[0, i] = jac[1, i1] * jac[2, i2] - jac[1, i2] * jac[2, i1]
-                cof[1, i] = jac[2, i1] * jac[0, i2] - jac[2, i2] * jac[0, i1]
-                cof[2, i] = jac[0, i1] * jac[1, i2] - jac[0, i2] * jac[1, i1]
-            det = jac[0, 0] * cof[0, 0] + jac[0, 1] * cof[0, 1] + jac[0, 2] * cof[0, 2]
+            det = _jacobian_det(x, bricks[b], dn_corner[c], jac, cof)
             ratio = det / j0[b, c]
             if ratio < fraction:
                 gc = np.empty((8, 3))
