@@ -122,16 +122,16 @@ def plan(spec: EPMapSpec) -> list[Task]:
         for a, b in pairs(spec):
             for fa in grid:
                 for fb in grid:
-                    add(jaw, _sum({a: fa}, {b: fb}))
+                    add(jaw, add_forces({a: fa}, {b: fb}))
         for g in spec.groups:
             for fi in [0.0, *spec.group_levels_n]:
                 for fa in grid:
                     for fb in grid:
-                        add(jaw, _sum({g.independent: fi}, {g.pair[0]: fa}, {g.pair[1]: fb}))
+                        add(jaw, add_forces({g.independent: fi}, {g.pair[0]: fa}, {g.pair[1]: fb}))
     return list(tasks)
 
 
-def _sum(*parts: dict[str, float]) -> dict[str, float]:
+def add_forces(*parts: dict[str, float]) -> dict[str, float]:
     out: dict[str, float] = {}
     for p in parts:
         for k, v in p.items():
@@ -173,7 +173,7 @@ _MODELS: dict[str, Model] = {}
 _RESTS: dict[tuple, State] = {}
 
 
-def _model(key: str, cfg_json: str, mesh_path: str) -> Model:
+def worker_model(key: str, cfg_json: str, mesh_path: str) -> Model:
     if key not in _MODELS:
         cfg = parse_config(json.loads(cfg_json), "<ep-map config>")
         mesh, wall, _ = load_mesh(mesh_path, expect=cfg)
@@ -182,25 +182,25 @@ def _model(key: str, cfg_json: str, mesh_path: str) -> Model:
     return _MODELS[key]
 
 
-def _rest(key: str, jaw_forces: Forces, cfg_json: str, mesh_path: str) -> State:
+def worker_rest(key: str, jaw_forces: Forces, cfg_json: str, mesh_path: str) -> State:
     if (key, jaw_forces) not in _RESTS:
-        _RESTS[(key, jaw_forces)] = jaw_rest(_model(key, cfg_json, mesh_path), dict(jaw_forces))
+        _RESTS[(key, jaw_forces)] = jaw_rest(worker_model(key, cfg_json, mesh_path), dict(jaw_forces))
     return _RESTS[(key, jaw_forces)]
 
 
 def compute_ep(key: str, jaw_forces: Forces, forces: Forces, spec_json: str, fast: bool, cfg_json: str,
                mesh_path: str) -> dict:
     """One EP as plain arrays (cached by joblib.Memory on everything but the last two arguments)."""
-    model = _model(key, cfg_json, mesh_path)
+    model = worker_model(key, cfg_json, mesh_path)
     spec = EPMapSpec.model_validate(json.loads(spec_json))
-    start = _rest(key, jaw_forces, cfg_json, mesh_path)
-    ep = equilibrium_point(model, start, _sum(dict(jaw_forces), dict(forces)), spec, fast)
+    start = worker_rest(key, jaw_forces, cfg_json, mesh_path)
+    ep = equilibrium_point(model, start, add_forces(dict(jaw_forces), dict(forces)), spec, fast)
     return {"x": ep.x, "drift_cm": ep.drift_cm, "converged": ep.converged, "stopped_ms": ep.stopped_ms}
 
 
 def compute_rest(key: str, jaw_forces: Forces, cfg_json: str, mesh_path: str) -> dict:
-    model = _model(key, cfg_json, mesh_path)
-    st = _rest(key, jaw_forces, cfg_json, mesh_path)
+    model = worker_model(key, cfg_json, mesh_path)
+    st = worker_rest(key, jaw_forces, cfg_json, mesh_path)
     return {"x": st.x[watch_nodes(model)].copy(), "mandible": st.x[model.node_sets["mandible"]].copy()}
 
 
@@ -226,7 +226,7 @@ def _spec_key(spec: EPMapSpec) -> str:
 # --- parallel execution -----------------------------------------------------------------------------
 
 @contextlib.contextmanager
-def _backend(backend: str, jobs: int, scheduler: str | None) -> Iterator[None]:
+def parallel_backend(backend: str, jobs: int, scheduler: str | None) -> Iterator[None]:
     from joblib import parallel_config
 
     if backend == "loky":
@@ -320,7 +320,7 @@ def build_ep_maps(mesh: Path | str = "data/mesh.h5", config: Path | str | None =
         progress(0, len(calls))
     # rests first (every EP of a jaw position starts from it), then the EPs, longest families last
     order = list(range(len(spec.jaw_positions))) + list(range(len(spec.jaw_positions), len(calls)))
-    with _backend(backend, jobs, scheduler):
+    with parallel_backend(backend, jobs, scheduler):
         for phase in (order[: len(spec.jaw_positions)], order[len(spec.jaw_positions):]):
             gen = Parallel(return_as="generator_unordered")(
                 delayed(_indexed)(i, calls[i][0], calls[i][1]) for i in phase)
@@ -412,7 +412,7 @@ def assemble(spec: EPMapSpec, rests: dict[str, np.ndarray], eps: dict,
         conv = np.zeros(shape, dtype=bool)
         drift = np.zeros(shape)
         for idx in np.ndindex(*shape):
-            xi, d, c = get(jaw, _sum(*({m: lv[i]} for m, lv, i in zip(muscles, levels, idx))))
+            xi, d, c = get(jaw, add_forces(*({m: lv[i]} for m, lv, i in zip(muscles, levels, idx))))
             x[idx], drift[idx], conv[idx] = xi, d, c
         return Net(muscles=muscles, levels=tuple(np.asarray(lv, dtype=float) for lv in levels), x=x,
                    converged=conv, drift_cm=drift)

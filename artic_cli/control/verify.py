@@ -18,7 +18,8 @@ import numpy as np
 
 from ..config import Config, load_config, model_hash
 from ..io.store import file_hash
-from .epmap import CONTROL_POINTS, JawMaps, _model, _rest, _sum, canonical, equilibrium_point
+from .epmap import (CONTROL_POINTS, JawMaps, add_forces, canonical, equilibrium_point, worker_model,
+                    worker_rest)
 from .solver import Candidate
 
 MAX_STEP_N = 1.5  # largest change of one force per refinement step
@@ -35,9 +36,9 @@ class Simulator:
 
     def reach(self, jaw_forces: dict[str, float], forces: dict[str, float]) -> np.ndarray:
         """(3, 3) tip, dorsum, jaw (cm) after holding the forces from the jaw position's rest."""
-        model = _model(self.key, self.cfg_json, self.mesh)
-        start = _rest(self.key, canonical(jaw_forces), self.cfg_json, self.mesh)
-        return equilibrium_point(model, start, _sum(dict(jaw_forces), forces), self.cfg.epmap).x
+        model = worker_model(self.key, self.cfg_json, self.mesh)
+        start = worker_rest(self.key, canonical(jaw_forces), self.cfg_json, self.mesh)
+        return equilibrium_point(model, start, add_forces(dict(jaw_forces), forces), self.cfg.epmap).x
 
 
 @dataclass

@@ -27,7 +27,7 @@ import numpy as np
 
 from .. import units
 from ..config import Config, load_config, model_hash, parse_config
-from ..control.epmap import _backend, canonical, control_for, physics_code_hash, watch_nodes
+from ..control.epmap import canonical, control_for, parallel_backend, physics_code_hash, watch_nodes
 from ..errors import ArticError
 from ..io.store import atomic_h5, file_hash, load_mesh, open_artifact
 from ..mechanics.model import Model, build_articulator
@@ -36,7 +36,7 @@ from ..mechanics.simulate import hold, settle
 _CACHE: dict[str, tuple[Model, object]] = {}
 
 
-def _model(key: str, cfg_json: str, mesh_path: str) -> tuple[Model, object]:
+def _model_and_rest(key: str, cfg_json: str, mesh_path: str) -> tuple[Model, object]:
     if key not in _CACHE:
         cfg = parse_config(json.loads(cfg_json), "<muscle-function config>")
         mesh, wall, _ = load_mesh(mesh_path, expect=cfg)
@@ -55,7 +55,7 @@ def starts(cfg: Config) -> list[tuple[int, tuple[float, ...]]]:
 def run_start(key: str, start_forces: tuple, start_ms: float, muscles: tuple[str, ...], drive_n: float,
               drive_ms: float, cfg_json: str, mesh_path: str) -> dict:
     """One start (``start_forces``: canonical (muscle, N) pairs) and every muscle's drive from it (cm)."""
-    model, rest = _model(key, cfg_json, mesh_path)
+    model, rest = _model_and_rest(key, cfg_json, mesh_path)
     watch = watch_nodes(model)
     forces = dict(start_forces)
     h = hold(model, rest, control_for(model, forces), units.ms_to_s(start_ms), watch, units.ms_to_s(start_ms))
@@ -114,7 +114,7 @@ def build_muscle_function(mesh: Path | str = "data/mesh.h5", config: Path | str 
     cached = sum(fn.check_call_in_cache(*a) for a in calls)
     results = [None] * len(calls)
     t0 = time.perf_counter()
-    with _backend("loky", jobs, None):
+    with parallel_backend("loky", jobs, None):
         gen = Parallel(return_as="generator_unordered")(delayed(_indexed)(i, fn, a) for i, a in enumerate(calls))
         for n, (i, r) in enumerate(gen, start=1):
             results[i] = r
@@ -123,7 +123,7 @@ def build_muscle_function(mesh: Path | str = "data/mesh.h5", config: Path | str 
     wall = time.perf_counter() - t0
     where = {forces: i for i, forces in enumerate(unique)}
     results = [results[where[k]] for k in keys]
-    model, rest = _model(key, cfg_json, str(mesh))
+    model, rest = _model_and_rest(key, cfg_json, str(mesh))
     mf = MuscleFunction(muscles=list(spec.muscles), combinations=[list(c) for c in spec.start_combinations],
                         combo=np.array([c for c, _ in todo]),
                         start_forces=np.array([lv for _, lv in todo], dtype=float),
