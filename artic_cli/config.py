@@ -130,6 +130,7 @@ class Jaw(_Strict):
     eminence_slope_deg: Annotated[float, Field(ge=-80, le=0)] = -30.0
     guide_stiffness_n_per_cm: Positive = 1000.0
     fossa_stop: bool = True           # the condyle cannot slide back beyond its rest seat in the glenoid fossa
+    fossa_stop_onset_cm: Positive = 0.01  # the stop's force rises smoothly over this depth (Newton stays smooth)
     passive_stiffness_n_per_cm: NonNeg = 0.5
     passive_relaxation_ms: NonNeg = 100.0  # jaw units' and straps' dashpots: this time x their spring
     strap_stiffness_n_per_cm: NonNeg = 10.0

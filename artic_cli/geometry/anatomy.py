@@ -26,7 +26,7 @@ from ..config import Config
 from ..errors import ArticError
 from .mesh import Mesh, tongue_node_index, tongue_mesh
 
-LINK_KINDS = ("mandible", "hyoid", "carried", "floor", "strap")
+LINK_KINDS = ("mandible", "hyoid", "floor", "strap")
 TONGUE_MUSCLES = ("GGa", "GGm", "GGp", "HG", "SG", "SL", "IL", "T", "V", "GH", "MH")
 JAW_MUSCLES = ("temporalis_anterior", "temporalis_posterior", "masseter", "medial_pterygoid",
                "lateral_pterygoid_upper", "lateral_pterygoid_lower", "anterior_digastric", "posterior_digastric")
@@ -43,6 +43,8 @@ class Body:
     fibre_weight: dict[str, np.ndarray]  # muscle -> share of the muscle's force per fibre
     fixed: np.ndarray  # skull points (all dofs fixed)
     mandible: np.ndarray  # nodes moving with the mandible (incl. carried points)
+    carried: np.ndarray  # points fixed to the mandible (incisor, muscle origins, the tongue's GG origin line)
+    carrier: np.ndarray  # (4,) mandible nodes whose rigid motion carries them
     hyoid: np.ndarray
     node_sets: dict[str, np.ndarray] = field(default_factory=dict)
 
@@ -109,12 +111,10 @@ def build_body(cfg: Config, mesh: Mesh | None = None) -> Body:
     for p, q in (("symphysis", "gonion"), ("symphysis", "condyle"), ("coronoid", "condyle"), ("gonion", "coronoid")):
         link(L[p], R[q], "mandible")
         link(R[p], L[q], "mandible")
+    # carried points move rigidly with the mandible (no links: see mechanics.model.Carried)
     frame = [jaw["symphysis"][0], jaw["symphysis"][1], jaw["coronoid"][0], jaw["gonion"][1]]
     carried = [incisor, gh_origin, *myl_front, *myl_back, *myl_mid, *dig_fossa]
     anchor = mesh.node_sets["anchor"]
-    for node in [*carried, *anchor]:
-        for f in frame:
-            link(int(node), f, "carried")
 
     # --- hyoid: body ends and horn tips, braced ---------------------------------------
     body_l, body_r = b.bilateral("hyoid_body", lm("hyoid_body_end"))
@@ -213,4 +213,5 @@ def build_body(cfg: Config, mesh: Mesh | None = None) -> Body:
     sets["hyoid"] = hyoid
     return Body(mesh=mesh, nodes=nodes, names=b.names, links=np.array(links, dtype=np.int64),
                 link_kind=np.array(kinds), fibres=fib, fibre_weight=weights, fixed=np.array(fixed),
-                mandible=mandible, hyoid=hyoid, node_sets=sets)
+                mandible=mandible, carried=np.array([*carried, *anchor], dtype=np.int64),
+                carrier=np.array(frame, dtype=np.int64), hyoid=hyoid, node_sets=sets)

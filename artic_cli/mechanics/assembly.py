@@ -17,6 +17,7 @@ dense products.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
@@ -29,8 +30,9 @@ class BandPattern:
     n_free: int  # core + border
     n_core: int
     u: int  # half bandwidth of the core (upper)
-    dof_of: np.ndarray  # (3N,) position of each global dof (core first, then border), -1 if fixed
+    dof_of: np.ndarray  # (3N,) position of each global dof (core first, then border), -1 if fixed or slaved
     free_dofs: np.ndarray  # (n_free,) global dof at each position
+    reduce: sp.csr_matrix  # (3N, n_free) T: a change dq of the free dofs moves the nodes by T dq
 
     @property
     def n_border(self) -> int:
@@ -45,31 +47,48 @@ class BandPattern:
         nb = self.n_border
         return self.band_size + self.n_core * nb + nb * nb
 
-    def block_index(self, nodes: np.ndarray) -> np.ndarray:
-        """Flat storage indices of dense blocks over ``nodes`` (E, k): (E, 3k, 3k); unused -> ``size``."""
+    @cached_property
+    def reduce_t(self) -> sp.csr_matrix:
+        """T^T: node forces (3N,) -> generalised forces on the free dofs."""
+        return self.reduce.T.tocsr()
+
+    def block_operator(self, nodes: np.ndarray) -> sp.csr_matrix:
+        """(size, E * 3k * 3k) operator taking dense element blocks over ``nodes`` (E, k) to flat storage.
+
+        It computes T^T K T for the element matrices K (slaved dofs spread onto their masters, fixed dofs
+        dropped) and keeps the stored part: the band's upper triangle, B and C."""
         e, k = nodes.shape
         dofs = (3 * nodes[:, :, None] + np.arange(3)).reshape(e, 3 * k)
-        pos = self.dof_of[dofs]
-        r = pos[:, :, None]
-        c = pos[:, None, :]
+        width = int(np.diff(self.reduce.indptr).max(initial=1))
+        cols, wts = _padded_rows(self.reduce, width)  # (3N, w)
+        a = np.broadcast_to(dofs[:, :, None], (e, 3 * k, 3 * k)).ravel()
+        b = np.broadcast_to(dofs[:, None, :], (e, 3 * k, 3 * k)).ravel()
+        entry = np.arange(a.size)
+        r = cols[a][:, :, None]
+        c = cols[b][:, None, :]
+        w = wts[a][:, :, None] * wts[b][:, None, :]
+        flat = self._flat(np.broadcast_to(r, w.shape), np.broadcast_to(c, w.shape))
+        keep = (w != 0.0) & (flat >= 0)
+        ent = np.broadcast_to(entry[:, None, None], w.shape)[keep]
+        return sp.csr_matrix((w[keep], (flat[keep], ent)), shape=(self.size, a.size))
+
+    def diagonal_operator(self, nodes: np.ndarray) -> sp.csr_matrix:
+        """Operator for 3x3 blocks on the diagonal at ``nodes`` (E,)."""
+        return self.block_operator(nodes[:, None])
+
+    def _flat(self, r: np.ndarray, c: np.ndarray) -> np.ndarray:
+        """Flat storage index of matrix entry (r, c), -1 where it is not stored."""
         nc, nb = self.n_core, self.n_border
-        valid = (r >= 0) & (c >= 0)
-        band = valid & (r < nc) & (c < nc) & (r <= c)
-        off = valid & (r < nc) & (c >= nc)
-        corner = valid & (r >= nc) & (c >= nc)
-        flat = np.full(r.shape[:1] + (3 * k, 3 * k), self.size, dtype=np.int64)
+        band = (r < nc) & (c < nc) & (r <= c)
+        off = (r < nc) & (c >= nc)
+        corner = (r >= nc) & (c >= nc)
+        flat = np.full(r.shape, -1, dtype=np.int64)
         flat = np.where(band, (self.u + r - c) * nc + c, flat)
         flat = np.where(off, self.band_size + r * nb + (c - nc), flat)
-        flat = np.where(corner, self.band_size + nc * nb + (r - nc) * nb + (c - nc), flat)
-        return flat
+        return np.where(corner, self.band_size + nc * nb + (r - nc) * nb + (c - nc), flat)
 
-    def diagonal_index(self, nodes: np.ndarray) -> np.ndarray:
-        """Indices of 3x3 blocks on the diagonal at ``nodes`` (E,): (E, 3, 3)."""
-        return self.block_index(nodes[:, None])
-
-    def assemble(self, index: np.ndarray, values: np.ndarray) -> "SystemMatrix":
-        acc = np.bincount(index.ravel(), weights=values.ravel(), minlength=self.size + 1)
-        return self.unpack(acc[: self.size])
+    def assemble(self, operator: sp.csr_matrix, values: np.ndarray) -> "SystemMatrix":
+        return self.unpack(operator @ values.ravel())
 
     def unpack(self, flat: np.ndarray) -> "SystemMatrix":
         nc, nb = self.n_core, self.n_border
@@ -77,6 +96,19 @@ class BandPattern:
         b = flat[self.band_size: self.band_size + nc * nb].reshape(nc, nb)
         c = flat[self.band_size + nc * nb:].reshape(nb, nb)
         return SystemMatrix(band, b, c)
+
+
+def _padded_rows(t: sp.csr_matrix, width: int) -> tuple[np.ndarray, np.ndarray]:
+    """Each row's column indices and values, padded to ``width`` with (0, 0.0)."""
+    n = t.shape[0]
+    counts = np.diff(t.indptr)
+    cols = np.zeros((n, width), dtype=np.int64)
+    vals = np.zeros((n, width))
+    slot = np.arange(t.nnz) - np.repeat(t.indptr[:-1], counts)
+    row = np.repeat(np.arange(n), counts)
+    cols[row, slot] = t.indices
+    vals[row, slot] = t.data
+    return cols, vals
 
 
 @dataclass
@@ -106,26 +138,49 @@ def _half_bandwidth(order: np.ndarray, pairs: np.ndarray, core_free: np.ndarray)
     return max(int(span.max()), 2), dof_of, free
 
 
-def band_pattern(n_nodes: int, pairs: np.ndarray, fixed: np.ndarray, n_core: int | None = None) -> BandPattern:
+def band_pattern(n_nodes: int, pairs: np.ndarray, fixed: np.ndarray, n_core: int | None = None,
+                 slaves: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None) -> BandPattern:
     """Pattern for a node graph with edges ``pairs`` and fixed dof mask (N,3).
 
     Nodes ``0 .. n_core-1`` form the banded core, in their given order or in
     reverse Cuthill-McKee order, whichever band is narrower; the other free
-    nodes form the dense border."""
+    nodes form the dense border.  ``slaves`` = (nodes (S,), masters (S,m),
+    weights (S,m)): each slaved node moves as the weighted sum of its masters
+    (border nodes) and has no degrees of freedom of its own."""
     n_core = n_nodes if n_core is None else n_core
     fixed = np.asarray(fixed, dtype=bool)
-    core_pairs = pairs[(pairs < n_core).all(axis=1)] if len(pairs) else pairs
+    slaved = np.zeros(n_nodes, dtype=bool)
+    if slaves is not None:
+        slaved[slaves[0]] = True
+    core = np.zeros(n_nodes, dtype=bool)
+    core[:n_core] = ~slaved[:n_core]
+    core_pairs = pairs[core[pairs].all(axis=1)] if len(pairs) else pairs
     adj = sp.coo_matrix((np.ones(len(core_pairs)), (core_pairs[:, 0], core_pairs[:, 1])), shape=(n_core, n_core))
     adj = (adj + adj.T + sp.eye(n_core)).tocsr()
     core_free = np.zeros(3 * n_nodes, dtype=bool)
-    core_free[: 3 * n_core] = ~fixed[:n_core].ravel()
+    core_free[: 3 * n_core] = (~fixed[:n_core] & core[:n_core, None]).ravel()
     candidates = [np.arange(n_core), reverse_cuthill_mckee(adj, symmetric_mode=True)]
     u, dof_of, free = min((_half_bandwidth(o, core_pairs, core_free) for o in candidates), key=lambda r: r[0])
     n_core_free = len(free)
-    border = np.flatnonzero(~fixed[n_core:].ravel()) + 3 * n_core
+    border_mask = ~fixed[n_core:] & ~slaved[n_core:, None]
+    border = np.flatnonzero(border_mask.ravel()) + 3 * n_core
     dof_of[border] = n_core_free + np.arange(len(border))
-    return BandPattern(n_free=n_core_free + len(border), n_core=n_core_free, u=u, dof_of=dof_of,
-                       free_dofs=np.concatenate([free, border]))
+    n_free = n_core_free + len(border)
+    own = np.flatnonzero(dof_of >= 0)
+    rows, cols, vals = [own], [dof_of[own]], [np.ones(len(own))]
+    if slaves is not None:
+        nodes, masters, weights = (np.asarray(a) for a in slaves)
+        for d in range(3):
+            m = dof_of[3 * masters + d]
+            if (m < 0).any():
+                raise ValueError("a slaved node's master is fixed or slaved itself")
+            rows.append(np.repeat(3 * nodes + d, masters.shape[1]))
+            cols.append(m.ravel())
+            vals.append(weights.ravel())
+    reduce = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                           shape=(3 * n_nodes, n_free))
+    return BandPattern(n_free=n_free, n_core=n_core_free, u=u, dof_of=dof_of,
+                       free_dofs=np.concatenate([free, border]), reduce=reduce)
 
 
 @dataclass

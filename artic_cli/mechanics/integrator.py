@@ -26,6 +26,7 @@ from . import elements, kernels
 from .assembly import add_low_rank, factorize, pair_blocks
 from .contact import ContactPlanes, contact_planes, enforce
 from .model import Control, Model, State
+from .penalty import ramp
 from .muscles import FibreState, fibre_state, fibre_stiffness, length_gradients, muscle_forces
 from ..geometry.hexahedra import SHAPE_GRADIENTS_CORNER, SHAPE_GRADIENTS_GAUSS
 from .volume import GUARD_FRACTION, corner_guard, volume_forces
@@ -77,8 +78,8 @@ def guide_forces(model: Model, x: np.ndarray) -> np.ndarray:
         f[gd.nodes] = -gd.stiffness * np.einsum("gm,gmi->gi", off, gd.normals)
         behind = guide_stop(gd, x)
         if behind.any():
-            s = np.einsum("gi,gi->g", d, gd.path)
-            f[gd.nodes] -= gd.stiffness * np.where(behind, s, 0.0)[:, None] * gd.path
+            push, _ = ramp(-np.einsum("gi,gi->g", d, gd.path), gd.onset)
+            f[gd.nodes] += gd.stiffness * push[:, None] * gd.path
     return f
 
 
@@ -128,28 +129,23 @@ def tangent(model: Model, cs: elements.CylinderState, frame: elements.DampingFra
         k3 = (k_nn[:, None, None] * (cs.n[:, :, None] * cs.n[:, None, :]) + k_geo[:, None, None] * _EYE
               + (c_v * frame.c)[:, None, None] * (frame.n[:, :, None] * frame.n[:, None, :]))
         blocks = pair_blocks(k3)
-    idx = [model.cyl_index]
-    val = [blocks]
+    pt = model.pattern
+    flat = model.cyl_op @ blocks.ravel()
     if grad is not None:
         g = grad.reshape(len(model.brick_v0), 24)
         w = model.kappa / model.brick_v0
-        idx.append(model.brick_index)
-        val.append(w[:, None, None] * g[:, :, None] * g[:, None, :])
+        flat += model.brick_op @ (w[:, None, None] * g[:, :, None] * g[:, None, :]).ravel()
     if fs is not None:
         t = np.maximum(fs.tension[model.muscles.seg_fibre], 0.0) / fs.seg_length
         nn = fs.n[:, :, None] * fs.n[:, None, :]
         kf = fibre_stiffness(model.muscles, fs, act, h)
         soft = np.where(kf < _RANK_ONE_STIFFNESS, kf * model.muscles.fibre_l0, 0.0)  # split in series
         kk = t[:, None, None] * (_EYE - nn) + (soft[model.muscles.seg_fibre] / model.muscles.seg_l0)[:, None, None] * nn
-        idx.append(model.seg_index)
-        val.append(pair_blocks(kk))
+        flat += model.seg_op @ pair_blocks(kk).ravel()
     if model.guide is not None:
         gd = model.guide
-        idx.append(gd.index)
-        val.append(gd.stiffness * np.einsum("gmi,gmj->gij", gd.normals, gd.normals))
-    flat_i = np.concatenate([i.ravel() for i in idx])
-    flat_v = np.concatenate([v.ravel() for v in val])
-    return c_a * model.mass_matrix + model.pattern.assemble(flat_i, flat_v)
+        flat += gd.operator @ (gd.stiffness * np.einsum("gmi,gmj->gij", gd.normals, gd.normals)).ravel()
+    return c_a * model.mass_matrix + pt.unpack(flat)
 
 
 def rank_one_terms(model: Model, x: np.ndarray, fs: FibreState | None, act: np.ndarray | None, h: float,
@@ -189,7 +185,8 @@ def rank_one_terms(model: Model, x: np.ndarray, fs: FibreState | None, act: np.n
         v = np.zeros((model.n_nodes, 3, int(stop.sum())))
         v[gd.nodes[stop], :, np.arange(int(stop.sum()))] = gd.path[stop]
         cols.append(v.reshape(n3, -1))
-        ks.append(np.full(int(stop.sum()), gd.stiffness))
+        _, slope = ramp(-np.einsum("gi,gi->g", x[gd.nodes[stop]] - gd.origin[stop], gd.path[stop]), gd.onset)
+        ks.append(gd.stiffness * slope)
     if not cols:
         return np.zeros((n3, 0)), np.zeros(0)
     return np.hstack(cols), np.concatenate(ks)
@@ -248,9 +245,11 @@ def _step_once(model: Model, state: State, control: Control, h: float) -> State:
     opt = model.options
     c_a, a_known, c_v, v_known, history = _coefficients(model, state, h)
     f_ext = control.force + model.node_mass[:, None] * model.gravity
-    free = model.pattern.free_dofs
+    reduce, reduce_t = model.pattern.reduce, model.pattern.reduce_t
     x = _predict(state, h)
     x[model.fixed] = state.x[model.fixed]
+    if model.carried is not None:
+        model.carried.place(x)
     refactors = state.refactors
     frame = elements.damping_frame(model.cyl, state.x)
     planes = None
@@ -279,7 +278,7 @@ def _step_once(model: Model, state: State, control: Control, h: float) -> State:
                       () if guard is None else tuple(zip(guard[0].tolist(), guard[1].tolist())))
         if factor is not None and active_key != factor.terms_key:
             factor = None  # contact set changed: keep the band, redo the small Woodbury part
-        resid = (model.mass @ a - f - f_ext).ravel()[free]
+        resid = reduce_t @ (model.mass @ a - f - f_ext).ravel()
         if factor is None:
             try:
                 if base is None:
@@ -289,7 +288,7 @@ def _step_once(model: Model, state: State, control: Control, h: float) -> State:
                         base = factorize(tangent(model, cs, frame, grad, fs, act, h, c_a, c_v, False), key)
                     refactors += 1
                 vecs, ks = rank_one_terms(model, x, fs, act, h, planes, active, guard)
-                factor = add_low_rank(base, vecs[free], ks, active_key)
+                factor = add_low_rank(base, np.asarray(reduce_t @ vecs), ks, active_key)
             except np.linalg.LinAlgError:
                 raise SimulationDiverged(f"the tissue lost stability at t = {state.t * 1e3:.1f} ms (tangent not "
                                          "positive definite); lower the loads or --dt") from None
@@ -302,7 +301,7 @@ def _step_once(model: Model, state: State, control: Control, h: float) -> State:
             dx *= _MAX_INCREMENT / size
             if not fresh:
                 factor = base = None
-        x.reshape(-1)[free] -= dx
+        x -= (reduce @ dx).reshape(-1, 3)
         if size < opt.tol:
             break
         if prev is not None and size > opt.refactor_rate * prev and not fresh:

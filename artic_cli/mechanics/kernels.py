@@ -167,13 +167,14 @@ def brick_terms(x, bricks, dn_gauss, dn_corner, v0, kappa, j0, guard_w, fraction
                         gc[a, i] = (cof[0, i] * dn_corner[c, a, 0] + cof[1, i] * dn_corner[c, a, 1]
                                     + cof[2, i] * dn_corner[c, a, 2]) / j0[b, c]
                 w = guard_w[b]
-                push = w * (fraction - ratio)
+                depth = fraction - ratio
+                push = w * depth * depth / fraction
                 for a in range(8):
                     for i in range(3):
                         f[bricks[b, a], i] += push * gc[a, i]
                 gk.append((b, c))
                 gg.append(gc)
-                gw.append(w)
+                gw.append(2.0 * w * depth / fraction)
     k = len(gk)
     pairs = np.empty((k, 2), dtype=np.int64)
     gout = np.empty((k, 8, 3))

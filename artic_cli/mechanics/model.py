@@ -9,8 +9,8 @@ forces of the current step.  Everything is CGS inside (cm, g, s, dyn).
 
 Two bodies share this model: the tongue alone (``build_model``: bricks and
 cylinders, some node sets held fixed) and the whole articulator
-(``build_articulator``: tongue, jaw and hyoid as stiff links, muscles,
-condyle guide, wall contact).
+(``build_articulator``: tongue, jaw and hyoid as stiff links, the points the
+mandible carries, muscles, condyle guide, wall contact).
 """
 
 from __future__ import annotations
@@ -50,15 +50,45 @@ class Guide:
 
     With ``path`` (the line's forward direction) the line ends at ``x0``: a
     node behind it (s = (x - x0) . path < 0, the condyle pressed into the back
-    of the glenoid fossa) is pushed forward with -k s path.
+    of the glenoid fossa) is pushed forward with k ramp(-s) path, the penalty
+    of :mod:`.penalty` with a smoothed onset over ``onset`` cm.
     """
 
     nodes: np.ndarray  # (G,)
     origin: np.ndarray  # (G,3)
     normals: np.ndarray  # (G,2,3)
     stiffness: float  # dyn/cm
-    index: np.ndarray  # (G,3,3) storage indices
+    operator: sp.csr_matrix  # diagonal 3x3 blocks at the nodes -> flat storage
     path: np.ndarray | None = None  # (G,3) forward unit vectors: a one-sided stop at the origin
+    onset: float = 0.0  # cm over which the stop's force rises smoothly
+
+
+@dataclass(frozen=True)
+class Carried:
+    """Points carried rigidly by a bone: each is a fixed affine combination of four of the bone's nodes.
+
+    Four non-coplanar points determine a rigid motion, and an affine map keeps
+    affine combinations, so x = sum_m w_m x_m holds exactly for any rigid
+    motion of the four; the points have no degrees of freedom of their own.
+    """
+
+    nodes: np.ndarray  # (S,)
+    masters: np.ndarray  # (S,4)
+    weights: np.ndarray  # (S,4), each row sums to 1
+
+    def place(self, x: np.ndarray) -> np.ndarray:
+        """``x`` with the carried points put where their masters say (in place, returned)."""
+        x[self.nodes] = np.einsum("sm,smi->si", self.weights, x[self.masters])
+        return x
+
+
+def carried_points(rest: np.ndarray, nodes: np.ndarray, frame: np.ndarray) -> Carried:
+    """Barycentric weights of ``nodes`` in the tetrahedron of the four ``frame`` nodes, at ``rest``."""
+    a = np.vstack([rest[frame].T, np.ones(4)])  # (4,4)
+    if abs(np.linalg.det(a)) < 1e-9:
+        raise ArticError("the mandible's carrying frame is flat; check the landmarks")
+    w = np.linalg.solve(a, np.vstack([rest[nodes].T, np.ones(len(nodes))])).T  # (S,4)
+    return Carried(nodes=np.asarray(nodes), masters=np.broadcast_to(frame, (len(nodes), 4)).copy(), weights=w)
 
 
 @dataclass(frozen=True)
@@ -74,23 +104,23 @@ class Model:
     gravity: np.ndarray  # (3,) cm/s^2
     fixed: np.ndarray  # (N,3) bool
     pattern: BandPattern
-    cyl_index: np.ndarray  # (C,6,6) storage indices
-    brick_index: np.ndarray  # (B,24,24)
+    cyl_op: sp.csr_matrix  # (C,6,6) element blocks -> flat storage (BandPattern.block_operator)
+    brick_op: sp.csr_matrix  # (B,24,24) blocks -> flat storage
     mass_matrix: object  # SystemMatrix of M
     scatter: sp.csr_matrix  # (N, C): node force = scatter @ (T n)
     options: SolverOptions = field(default_factory=SolverOptions)
     node_sets: dict = field(default_factory=dict)
     names: dict = field(default_factory=dict)
     muscles: MuscleSet | None = None
-    seg_index: np.ndarray | None = None  # (S,6,6)
+    seg_op: sp.csr_matrix | None = None  # (S,6,6) blocks -> flat storage
     groups: dict = field(default_factory=dict)  # group -> {muscle: share}
     guide: Guide | None = None
     contact: ContactModel | None = None
-    contact_index: np.ndarray | None = None  # (P,3,3) for contact nodes
     wall: WallSurface | None = None
     tone: np.ndarray | None = None  # (M,) postural muscle forces, dyn, added to every control's
     corner_j0: np.ndarray | None = None  # (B,8) rest corner Jacobians (inversion guard)
     guard_weight: np.ndarray | None = None  # (B,) guard stiffness w = bulk x V0 / 8, erg
+    carried: Carried | None = None  # points that move rigidly with the mandible
 
     @property
     def n_nodes(self) -> int:
@@ -201,27 +231,26 @@ def _finish(mesh: Mesh, rest: np.ndarray, cyl: CylinderSet, link_mass: np.ndarra
     ms = extra.get("muscles")
     if ms is not None:
         all_pairs = np.vstack([all_pairs, np.column_stack([ms.seg_i, ms.seg_j])])
-    pattern = band_pattern(n, all_pairs, fixed, n_core)
-    cyl_pairs = np.column_stack([cyl.i, cyl.j])
-    cyl_index = pattern.block_index(cyl_pairs)
-    brick_index = pattern.block_index(mesh.bricks)
+    carried = extra.get("carried")
+    slaves = None if carried is None else (carried.nodes, carried.masters, carried.weights)
+    pattern = band_pattern(n, all_pairs, fixed, n_core, slaves)
+    cyl_op = pattern.block_operator(np.column_stack([cyl.i, cyl.j]))
+    brick_op = pattern.block_operator(mesh.bricks)
     mblock = np.kron(np.array([[2.0, 1.0], [1.0, 2.0]]), np.eye(3))[None] * (link_mass / 6.0)[:, None, None]
-    mass_matrix = pattern.assemble(cyl_index, mblock)
+    mass_matrix = pattern.assemble(cyl_op, mblock)
     ncyl = len(cyl.i)
     scatter = sp.csr_matrix((np.concatenate([np.ones(ncyl), -np.ones(ncyl)]),
                              (np.concatenate([cyl.i, cyl.j]), np.concatenate([np.arange(ncyl)] * 2))), shape=(n, ncyl))
     if ms is not None:
-        extra["seg_index"] = pattern.block_index(np.column_stack([ms.seg_i, ms.seg_j]))
+        extra["seg_op"] = pattern.block_operator(np.column_stack([ms.seg_i, ms.seg_j]))
     guide = extra.pop("guide_spec", None)
     if guide is not None:
-        nodes, origin, normals, k, path = guide
+        nodes, origin, normals, k, path, onset = guide
         extra["guide"] = Guide(nodes=nodes, origin=origin, normals=normals, stiffness=k,
-                               index=pattern.diagonal_index(nodes), path=path)
-    if extra.get("contact") is not None:
-        extra["contact_index"] = pattern.diagonal_index(extra["contact"].nodes)
+                               operator=pattern.diagonal_operator(nodes), path=path, onset=onset)
     return Model(mesh=mesh, rest=rest, cyl=cyl, bricks=mesh.bricks, brick_v0=v0,
                  kappa=kappa, mass=mass, node_mass=node_mass, gravity=np.array([0.0, -gravity, 0.0]), fixed=fixed,
-                 pattern=pattern, cyl_index=cyl_index, brick_index=brick_index, mass_matrix=mass_matrix,
+                 pattern=pattern, cyl_op=cyl_op, brick_op=brick_op, mass_matrix=mass_matrix,
                  scatter=scatter, options=solver_options(sim), **extra)
 
 
@@ -248,7 +277,7 @@ def build_model(mesh: Mesh, tissue: TissueMaterial, sim: Simulation, *,
 
 
 def _links(body: Body, cfg: Config, tissue_scale: float) -> tuple[CylinderSet, np.ndarray]:
-    """Passive links of the articulator: bones, carried points, floor, straps, jaw muscles' passive springs."""
+    """Passive links of the articulator: bones, floor, straps, jaw muscles' passive springs."""
     jaw = cfg.jaw
     bone = cfg.materials.bone
     tissue = cfg.materials.tongue
@@ -265,7 +294,7 @@ def _links(body: Body, cfg: Config, tissue_scale: float) -> tuple[CylinderSet, n
     area = np.full(len(i), jaw.link_area_cm2)
     e = np.zeros(len(i))
     eta = np.zeros(len(i))
-    stiff = np.isin(kinds, [LINK_KINDS.index(k) for k in ("mandible", "hyoid", "carried")])
+    stiff = np.isin(kinds, [LINK_KINDS.index(k) for k in ("mandible", "hyoid")])
     e[stiff] = units.kpa_to_cgs(bone.youngs_modulus_kpa)
     eta[stiff] = units.kpa_to_cgs(bone.viscosity_kpa_s)
     floor = kinds == LINK_KINDS.index("floor")
@@ -334,7 +363,7 @@ def build_articulator(cfg: Config, mesh: Mesh, wall: WallSurface | None = None, 
     normals = np.array([[-path[1], path[0], 0.0], [0.0, 0.0, 1.0]])
     guide = (cond, body.nodes[cond], np.broadcast_to(normals, (2, 2, 3)).copy(),
              units.newton_to_dyn(cfg.jaw.guide_stiffness_n_per_cm),
-             np.broadcast_to(path, (2, 3)).copy() if cfg.jaw.fossa_stop else None)
+             np.broadcast_to(path, (2, 3)).copy() if cfg.jaw.fossa_stop else None, cfg.jaw.fossa_stop_onset_cm)
 
     cm = None
     use_contact = cfg.contact.enabled if contact is None else contact
@@ -358,4 +387,4 @@ def build_articulator(cfg: Config, mesh: Mesh, wall: WallSurface | None = None, 
                    bulk_ratio * scale * e0,
                    node_sets=dict(body.node_sets), names=dict(body.names), muscles=ms,
                    groups={k: dict(v) for k, v in mc.groups.items()}, guide_spec=guide, contact=cm, wall=wall,
-                   tone=tone)
+                   tone=tone, carried=carried_points(body.nodes, body.carried, body.carrier))

@@ -20,8 +20,10 @@ import numpy as np
 
 from ..geometry.hexahedra import corner_jacobians, corner_jacobians_at, volume_gradients, volumes
 
-# Inversion guard: a corner whose Jacobian falls below this fraction of its rest value is pushed back by
-# U = w / 2 (GUARD_FRACTION - J / J0)^2, w = bulk modulus x V0 / 8 (one eighth of the brick per corner).
+# Inversion guard: a corner whose Jacobian falls below this fraction f of its rest value is pushed back by
+# U = w / (3 f) (f - J / J0)^3, w = bulk modulus x V0 / 8 (one eighth of the brick per corner).  Cubic, so
+# its stiffness grows from zero at the threshold (a quadratic guard's stiffness jumps there, and Newton
+# chattered on and off it when a corner came to rest on the threshold); at J = 0 it pushes as hard (w f).
 # It is zero in ordinary motion and keeps bricks from turning inside out under extreme shear
 # (7 N antagonists pulling the midsagittal and parasagittal planes apart).
 GUARD_FRACTION = 0.25
@@ -54,7 +56,7 @@ def corner_guard(x: np.ndarray, bricks: np.ndarray, j0: np.ndarray, weight: np.n
         return f, None
     _, grad = corner_jacobians_at(x, bricks, b, c)
     g = grad / j0[b, c][:, None, None]
-    w = weight[b]
-    contrib = (w * (GUARD_FRACTION - ratio[b, c]))[:, None, None] * g  # -dU/dx
+    depth = GUARD_FRACTION - ratio[b, c]
+    contrib = (weight[b] * depth**2 / GUARD_FRACTION)[:, None, None] * g  # -dU/dx
     np.add.at(f, bricks[b], contrib)
-    return f, (b, c, g, w)
+    return f, (b, c, g, 2.0 * weight[b] * depth / GUARD_FRACTION)
