@@ -21,7 +21,7 @@ from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.linalg import cho_factor, cho_solve, cho_solve_banded, cholesky_banded
+from scipy.linalg.lapack import dpbtrf, dpotrf, dpotrs, dtbtrs, dtrtrs
 from scipy.sparse.csgraph import reverse_cuthill_mckee
 
 
@@ -183,64 +183,96 @@ def band_pattern(n_nodes: int, pairs: np.ndarray, fixed: np.ndarray, n_core: int
                        free_dofs=np.concatenate([free, border]), reduce=reduce)
 
 
+def _check(info: int, what: str) -> None:
+    if info > 0:
+        raise np.linalg.LinAlgError(f"{what}: matrix not positive definite")
+    if info < 0:
+        raise ValueError(f"{what}: illegal argument {-info}")
+
+
 @dataclass
 class BandFactor:
-    """Cholesky factors of a bordered banded SPD matrix, with the key it was built for."""
+    """Block Cholesky factor L of a bordered banded SPD matrix, with the key it was built for.
+
+        [ A   B ]   [ U^T  0  ] [ U  W    ]
+        [ B^T C ] = [ W^T  Ls ] [ 0  Ls^T ],   W = U^-T B,  Ls Ls^T = C - W^T W
+
+    (A = U^T U banded).  ``forward`` applies L^-1 and ``backward`` L^-T, each one
+    banded triangular solve plus small dense work; LAPACK is called directly
+    (these systems are small, and the SciPy wrappers' checks cost more than the
+    solves)."""
 
     cb: np.ndarray
     key: tuple
-    y: np.ndarray | None = None  # A^-1 B
-    b: np.ndarray | None = None
-    schur: tuple | None = None
+    w: np.ndarray | None = None  # U^-T B (n_core, n_border)
+    ls: np.ndarray | None = None  # lower Cholesky factor of the Schur complement
+
+    def forward(self, rhs: np.ndarray) -> np.ndarray:
+        nc = self.cb.shape[1]
+        y1, info = dtbtrs(self.cb, rhs[:nc], uplo="U", trans="T")
+        _check(info, "banded solve")
+        if self.ls is None:
+            return y1
+        y2, info = dtrtrs(self.ls, rhs[nc:] - self.w.T @ y1, lower=1)
+        return np.concatenate([y1, y2])
+
+    def backward(self, y: np.ndarray) -> np.ndarray:
+        nc = self.cb.shape[1]
+        if self.ls is None:
+            x1, info = dtbtrs(self.cb, y, uplo="U", trans="N")
+            return x1
+        x2, info = dtrtrs(self.ls, y[nc:], lower=1, trans=1)
+        x1, info = dtbtrs(self.cb, y[:nc] - self.w @ x2, uplo="U", trans="N")
+        return np.concatenate([x1, x2])
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
-        nc = self.cb.shape[1]
-        z1 = cho_solve_banded((self.cb, False), rhs[:nc], check_finite=False)
-        if self.schur is None:
-            return z1
-        x2 = cho_solve(self.schur, rhs[nc:] - self.b.T @ z1, check_finite=False)
-        return np.concatenate([z1 - self.y @ x2, x2])
+        return self.backward(self.forward(rhs))
 
 
 @dataclass(frozen=True)
 class LowRankFactor:
-    """Solves with A + G diag(k) G^T by the Woodbury identity, from a factor of A."""
+    """Solves with A + G diag(k) G^T by the Woodbury identity, from a factor L of A.
+
+    With Z = L^-1 G:  (A + G K G^T)^-1 = L^-T (I - Z (K^-1 + Z^T Z)^-1 Z^T) L^-1."""
 
     base: BandFactor
     terms_key: tuple  # what the rank-one terms were built for
-    g: np.ndarray | None = None  # (n_free, r)
-    z: np.ndarray | None = None  # A^-1 G
-    s: tuple | None = None  # Cholesky of diag(1/k) + G^T A^-1 G
+    z: np.ndarray | None = None  # L^-1 G (n_free, r)
+    s: np.ndarray | None = None  # Cholesky (upper) of diag(1/k) + Z^T Z
 
     @property
     def key(self) -> tuple:
         return self.base.key
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
-        y = self.base.solve(rhs)
-        if self.g is None:
-            return y
-        return y - self.z @ cho_solve(self.s, self.g.T @ y, check_finite=False)
+        y = self.base.forward(rhs)
+        if self.z is not None:
+            c, _ = dpotrs(self.s, self.z.T @ y)
+            y = y - self.z @ c
+        return self.base.backward(y)
 
 
 def add_low_rank(base: BandFactor, g: np.ndarray, k: np.ndarray, terms_key: tuple = ()) -> LowRankFactor:
     """Factor of A + G diag(k) G^T (k > 0) for rank-one terms that do not fit the band."""
     if g.shape[1] == 0:
         return LowRankFactor(base=base, terms_key=terms_key)
-    z = base.solve(g)
-    return LowRankFactor(base=base, terms_key=terms_key, g=g, z=z,
-                         s=cho_factor(np.diag(1.0 / k) + g.T @ z, check_finite=False))
+    z = base.forward(np.ascontiguousarray(g))
+    s, info = dpotrf(np.diag(1.0 / k) + z.T @ z)
+    _check(info, "low-rank update")
+    return LowRankFactor(base=base, terms_key=terms_key, z=z, s=s)
 
 
 def factorize(mat: SystemMatrix, key: tuple) -> BandFactor:
-    cb = cholesky_banded(mat.band, lower=False, check_finite=False)
+    cb, info = dpbtrf(mat.band)
+    _check(info, "banded Cholesky")
     if mat.c.size == 0:
         return BandFactor(cb=cb, key=key)
-    y = np.zeros_like(mat.b)
-    coupled = np.flatnonzero(np.any(mat.b != 0.0, axis=0))  # border dofs with no link to the core need no solve
-    y[:, coupled] = cho_solve_banded((cb, False), mat.b[:, coupled], check_finite=False)
-    schur = cho_factor(mat.c - mat.b.T @ y, check_finite=False)
-    return BandFactor(cb=cb, key=key, y=y, b=mat.b, schur=schur)
+    w = np.zeros_like(mat.b)
+    coupled = np.flatnonzero(np.any(mat.b != 0.0, axis=0))  # border dofs with no link to the core: W = 0
+    w[:, coupled], info = dtbtrs(cb, mat.b[:, coupled], uplo="U", trans="T")
+    ls, info = dpotrf(mat.c - w.T @ w, lower=1)
+    _check(info, "Schur complement")
+    return BandFactor(cb=cb, key=key, w=w, ls=ls)
 
 
 def sparse_blocks(nodes: np.ndarray, blocks: np.ndarray, n_nodes: int) -> sp.csr_matrix:

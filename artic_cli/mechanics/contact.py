@@ -20,11 +20,13 @@ nodes, Kabsch), where that part is fixed, so both KD-trees are built once.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from scipy.spatial import cKDTree
 
 from ..geometry.wall import PARTS, WallSurface
+from . import elements, kernels
 
 
 @dataclass(frozen=True)
@@ -41,6 +43,11 @@ class ContactModel:
     tolerance: float  # cm
     margin: float = 0.5  # cm: nodes closer than this get a plane for the step
     neighbours: int = 6
+
+    @cached_property
+    def corners(self) -> np.ndarray:
+        """(T,3,3) the wall triangles' corner coordinates."""
+        return np.ascontiguousarray(self.wall.vertices[self.wall.triangles])
 
 
 def contact_model(wall: WallSurface, nodes: np.ndarray, jaw_nodes: np.ndarray, jaw_rest: np.ndarray,
@@ -100,6 +107,8 @@ def _nearest(cm: ContactModel, p: np.ndarray, tree: cKDTree, tris: np.ndarray):
     k = min(cm.neighbours, len(tris))
     _, idx = tree.query(p, k=k)
     idx = idx.reshape(len(p), k)
+    if kernels.AVAILABLE and elements.USE_KERNELS:
+        return kernels.nearest_on_triangles(np.ascontiguousarray(p), tris[idx], cm.corners, cm.wall.normals)
     t = cm.wall.triangles[tris[idx]]  # (P,k,3)
     v = cm.wall.vertices
     pp = np.repeat(p, k, axis=0)

@@ -302,7 +302,11 @@ def _step_once(model: Model, state: State, control: Control, h: float) -> State:
             if not fresh:
                 factor = base = None
         x -= (reduce @ dx).reshape(-1, 3)
-        if size < opt.tol:
+        # stop when the error left after this update is below tol: the increment itself, or, with a
+        # contraction rate theta < 1 measured, the geometric tail theta / (1 - theta) * size (Hairer &
+        # Wanner's stopping rule for simplified Newton)
+        theta = size / prev if prev else None
+        if size < opt.tol or (theta is not None and theta < 1.0 and theta / (1.0 - theta) * size < opt.tol):
             break
         if prev is not None and size > opt.refactor_rate * prev and not fresh:
             factor = base = None

@@ -109,15 +109,23 @@ def cylinder_blocks(n, length, elastic, axial, frame_n, frame_c, c_v, signed):
 
 
 @njit(cache=True, fastmath=False)
-def _jacobian_det(x, nodes, dn, jac, cof):
-    """det of the brick's Jacobian at one reference point (shape gradients ``dn`` (8,3)); fills ``jac`` (its
-    columns, jac[l, i]) and ``cof`` (d det / d column l = cross of the other two columns)."""
-    for i in range(3):
-        for l in range(3):
-            acc = 0.0
-            for a in range(8):
-                acc += x[nodes[a], i] * dn[a, l]
-            jac[l, i] = acc
+def _jacobian_det(xl, dn, jac, cof):
+    """det of a brick's Jacobian at one reference point (corner coordinates ``xl`` (8,3), shape gradients
+    ``dn`` (8,3)); fills ``jac`` (its columns, jac[l, i]) and ``cof`` (d det / d column l = cross of the
+    other two columns)."""
+    for l in range(3):
+        j0 = 0.0
+        j1 = 0.0
+        j2 = 0.0
+        for a in range(8):
+            d = dn[a, l]
+            if d != 0.0:  # at a corner only 2 of 8 shape gradients are non-zero per direction
+                j0 += xl[a, 0] * d
+                j1 += xl[a, 1] * d
+                j2 += xl[a, 2] * d
+        jac[l, 0] = j0
+        jac[l, 1] = j1
+        jac[l, 2] = j2
     for i in range(3):
         i1, i2 = (i + 1) % 3, (i + 2) % 3
         cof[0, i] = jac[1, i1] * jac[2, i2] - jac[1, i2] * jac[2, i1]
@@ -142,9 +150,13 @@ def brick_terms(x, bricks, dn_gauss, dn_corner, v0, kappa, j0, guard_w, fraction
     gw = []
     jac = np.empty((3, 3))
     cof = np.empty((3, 3))
+    xl = np.empty((8, 3))
     for b in range(nb):
+        for a in range(8):
+            for i in range(3):
+                xl[a, i] = x[bricks[b, a], i]
         for g in range(dn_gauss.shape[0]):
-            det = _jacobian_det(x, bricks[b], dn_gauss[g], jac, cof)
+            det = _jacobian_det(xl, dn_gauss[g], jac, cof)
             vol[b] += det
             for a in range(8):
                 for i in range(3):
@@ -158,7 +170,7 @@ def brick_terms(x, bricks, dn_gauss, dn_corner, v0, kappa, j0, guard_w, fraction
         if guard_w.shape[0] == 0:
             continue
         for c in range(8):
-            det = _jacobian_det(x, bricks[b], dn_corner[c], jac, cof)
+            det = _jacobian_det(xl, dn_corner[c], jac, cof)
             ratio = det / j0[b, c]
             if ratio < fraction:
                 gc = np.empty((8, 3))
@@ -185,3 +197,70 @@ def brick_terms(x, bricks, dn_gauss, dn_corner, v0, kappa, j0, guard_w, fraction
         gout[m] = gg[m]
         wout[m] = gw[m]
     return f, vol, grad, pairs, gout, wout
+
+
+@njit(cache=True, fastmath=False)
+def _dot(a0, a1, a2, b0, b1, b2):
+    return a0 * b0 + a1 * b1 + a2 * b2
+
+
+@njit(cache=True, fastmath=False)
+def _closest_on_triangle(p, t):
+    """Closest point on triangle t (3,3) to p (3,) (Ericson, Real-Time Collision Detection 5.1.5)."""
+    ab0, ab1, ab2 = t[1, 0] - t[0, 0], t[1, 1] - t[0, 1], t[1, 2] - t[0, 2]
+    ac0, ac1, ac2 = t[2, 0] - t[0, 0], t[2, 1] - t[0, 1], t[2, 2] - t[0, 2]
+    ap0, ap1, ap2 = p[0] - t[0, 0], p[1] - t[0, 1], p[2] - t[0, 2]
+    d1 = _dot(ab0, ab1, ab2, ap0, ap1, ap2)
+    d2 = _dot(ac0, ac1, ac2, ap0, ap1, ap2)
+    if d1 <= 0.0 and d2 <= 0.0:
+        return t[0, 0], t[0, 1], t[0, 2]
+    bp0, bp1, bp2 = p[0] - t[1, 0], p[1] - t[1, 1], p[2] - t[1, 2]
+    d3 = _dot(ab0, ab1, ab2, bp0, bp1, bp2)
+    d4 = _dot(ac0, ac1, ac2, bp0, bp1, bp2)
+    if d3 >= 0.0 and d4 <= d3:
+        return t[1, 0], t[1, 1], t[1, 2]
+    vc = d1 * d4 - d3 * d2
+    if vc <= 0.0 and d1 >= 0.0 and d3 <= 0.0:
+        v = d1 / (d1 - d3)
+        return t[0, 0] + v * ab0, t[0, 1] + v * ab1, t[0, 2] + v * ab2
+    cp0, cp1, cp2 = p[0] - t[2, 0], p[1] - t[2, 1], p[2] - t[2, 2]
+    d5 = _dot(ab0, ab1, ab2, cp0, cp1, cp2)
+    d6 = _dot(ac0, ac1, ac2, cp0, cp1, cp2)
+    if d6 >= 0.0 and d5 <= d6:
+        return t[2, 0], t[2, 1], t[2, 2]
+    vb = d5 * d2 - d1 * d6
+    if vb <= 0.0 and d2 >= 0.0 and d6 <= 0.0:
+        w = d2 / (d2 - d6)
+        return t[0, 0] + w * ac0, t[0, 1] + w * ac1, t[0, 2] + w * ac2
+    va = d3 * d6 - d5 * d4
+    if va <= 0.0 and (d4 - d3) >= 0.0 and (d5 - d6) >= 0.0:
+        w = (d4 - d3) / ((d4 - d3) + (d5 - d6))
+        return (t[1, 0] + w * (t[2, 0] - t[1, 0]), t[1, 1] + w * (t[2, 1] - t[1, 1]),
+                t[1, 2] + w * (t[2, 2] - t[1, 2]))
+    denom = 1.0 / (va + vb + vc)
+    v = vb * denom
+    w = vc * denom
+    return (t[0, 0] + v * ab0 + w * ac0, t[0, 1] + v * ab1 + w * ac1, t[0, 2] + v * ab2 + w * ac2)
+
+
+@njit(cache=True, fastmath=False)
+def nearest_on_triangles(p, candidates, corners, normals):
+    """For each point p (P,3), the closest point over its candidate triangles (P,k) (indices into
+    ``corners`` (T,3,3) and ``normals`` (T,3)): closest point (P,3), that triangle's normal (P,3) and the
+    signed distance along it (P,)."""
+    npt, k = candidates.shape
+    q = np.empty((npt, 3))
+    n = np.empty((npt, 3))
+    g = np.empty(npt)
+    for i in range(npt):
+        best = np.inf
+        for m in range(k):
+            t = candidates[i, m]
+            q0, q1, q2 = _closest_on_triangle(p[i], corners[t])
+            d = (p[i, 0] - q0) ** 2 + (p[i, 1] - q1) ** 2 + (p[i, 2] - q2) ** 2
+            if d < best:
+                best = d
+                q[i, 0], q[i, 1], q[i, 2] = q0, q1, q2
+                n[i] = normals[t]
+        g[i] = (p[i, 0] - q[i, 0]) * n[i, 0] + (p[i, 1] - q[i, 1]) * n[i, 1] + (p[i, 2] - q[i, 2]) * n[i, 2]
+    return q, n, g
