@@ -7,11 +7,13 @@ hyoid, which touch the whole tongue).  Every system matrix is then
     [ A   B ]      A: symmetric banded, half-bandwidth u (LAPACK upper storage)
     [ B^T C ]      B: dense n_core x n_border, C: dense n_border x n_border
 
-Each element block knows, once and for all, where its entries land in one
-flat storage (band | B | C | discard); assembly is one ``np.bincount``.  The
-factorisation is a banded Cholesky of A and a dense Cholesky of the Schur
-complement S = C - B^T A^-1 B, so a solve costs one banded solve plus small
-dense products.
+Nodes carried rigidly by a bone have no dofs of their own: a map T takes the
+free dofs to all node dofs, and the system matrix is T^T K T.  Each element
+block knows, once and for all, where its entries land in one flat storage
+(band | B | C), with T folded in: assembly is one sparse product.  The
+factorisation is a block Cholesky (banded U of A, W = U^-T B, dense Cholesky
+of the Schur complement C - W^T W); a solve is one banded forward and one
+banded backward substitution plus small dense products.
 """
 
 from __future__ import annotations
@@ -87,9 +89,6 @@ class BandPattern:
         flat = np.where(off, self.band_size + r * nb + (c - nc), flat)
         return np.where(corner, self.band_size + nc * nb + (r - nc) * nb + (c - nc), flat)
 
-    def assemble(self, operator: sp.csr_matrix, values: np.ndarray) -> "SystemMatrix":
-        return self.unpack(operator @ values.ravel())
-
     def unpack(self, flat: np.ndarray) -> "SystemMatrix":
         nc, nb = self.n_core, self.n_border
         band = flat[: self.band_size].reshape(self.u + 1, nc)
@@ -116,14 +115,6 @@ class SystemMatrix:
     band: np.ndarray
     b: np.ndarray
     c: np.ndarray
-
-    def __add__(self, other: "SystemMatrix") -> "SystemMatrix":
-        return SystemMatrix(self.band + other.band, self.b + other.b, self.c + other.c)
-
-    def __mul__(self, s: float) -> "SystemMatrix":
-        return SystemMatrix(self.band * s, self.b * s, self.c * s)
-
-    __rmul__ = __mul__
 
 
 def _half_bandwidth(order: np.ndarray, pairs: np.ndarray, core_free: np.ndarray):

@@ -129,23 +129,27 @@ def tangent(model: Model, cs: elements.CylinderState, frame: elements.DampingFra
         k3 = (k_nn[:, None, None] * (cs.n[:, :, None] * cs.n[:, None, :]) + k_geo[:, None, None] * _EYE
               + (c_v * frame.c)[:, None, None] * (frame.n[:, :, None] * frame.n[:, None, :]))
         blocks = pair_blocks(k3)
-    pt = model.pattern
-    flat = model.cyl_op @ blocks.ravel()
+    vals = [blocks.ravel()]
+    nb = len(model.brick_v0)
     if grad is not None:
-        g = grad.reshape(len(model.brick_v0), 24)
+        g = grad.reshape(nb, 24)
         w = model.kappa / model.brick_v0
-        flat += model.brick_op @ (w[:, None, None] * g[:, :, None] * g[:, None, :]).ravel()
+        vals.append((w[:, None, None] * g[:, :, None] * g[:, None, :]).ravel())
+    else:
+        vals.append(np.zeros(nb * 576))
     if fs is not None:
         t = np.maximum(fs.tension[model.muscles.seg_fibre], 0.0) / fs.seg_length
         nn = fs.n[:, :, None] * fs.n[:, None, :]
         kf = fibre_stiffness(model.muscles, fs, act, h)
         soft = np.where(kf < _RANK_ONE_STIFFNESS, kf * model.muscles.fibre_l0, 0.0)  # split in series
         kk = t[:, None, None] * (_EYE - nn) + (soft[model.muscles.seg_fibre] / model.muscles.seg_l0)[:, None, None] * nn
-        flat += model.seg_op @ pair_blocks(kk).ravel()
-    if model.guide is not None:
-        gd = model.guide
-        flat += gd.operator @ (gd.stiffness * np.einsum("gmi,gmj->gij", gd.normals, gd.normals)).ravel()
-    return c_a * model.mass_matrix + pt.unpack(flat)
+        vals.append(pair_blocks(kk).ravel())
+    elif model.muscles is not None:
+        vals.append(np.zeros(len(model.muscles.seg_i) * 36))
+    flat = model.tangent_op @ np.concatenate(vals)
+    flat += c_a * model.mass_flat
+    flat += model.guide_flat
+    return model.pattern.unpack(flat)
 
 
 def rank_one_terms(model: Model, x: np.ndarray, fs: FibreState | None, act: np.ndarray | None, h: float,

@@ -264,3 +264,36 @@ def nearest_on_triangles(p, candidates, corners, normals):
                 n[i] = normals[t]
         g[i] = (p[i, 0] - q[i, 0]) * n[i, 0] + (p[i, 1] - q[i, 1]) * n[i, 1] + (p[i, 2] - q[i, 2]) * n[i, 2]
     return q, n, g
+
+
+@njit(cache=True, fastmath=False)
+def fibre_geometry(x, seg_i, seg_j, seg_fibre, n_fibres):
+    """Segment unit vectors (S,3), segment lengths (S,) and fibre lengths (F,)."""
+    s = len(seg_i)
+    n = np.empty((s, 3))
+    length = np.empty(s)
+    total = np.zeros(n_fibres)
+    for k in range(s):
+        a, b = seg_i[k], seg_j[k]
+        d0 = x[b, 0] - x[a, 0]
+        d1 = x[b, 1] - x[a, 1]
+        d2 = x[b, 2] - x[a, 2]
+        ln = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        length[k] = ln
+        n[k, 0] = d0 / ln
+        n[k, 1] = d1 / ln
+        n[k, 2] = d2 / ln
+        total[seg_fibre[k]] += ln
+    return n, length, total
+
+
+@njit(cache=True, fastmath=False)
+def fibre_forces(n, tension, seg_i, seg_j, seg_fibre, n_nodes):
+    """(N,3) nodal forces of fibres pulling with ``tension`` (F,) along their segments."""
+    f = np.zeros((n_nodes, 3))
+    for k in range(len(seg_i)):
+        t = tension[seg_fibre[k]]
+        for i in range(3):
+            f[seg_i[k], i] += t * n[k, i]
+            f[seg_j[k], i] -= t * n[k, i]
+    return f

@@ -58,7 +58,6 @@ class Guide:
     origin: np.ndarray  # (G,3)
     normals: np.ndarray  # (G,2,3)
     stiffness: float  # dyn/cm
-    operator: sp.csr_matrix  # diagonal 3x3 blocks at the nodes -> flat storage
     path: np.ndarray | None = None  # (G,3) forward unit vectors: a one-sided stop at the origin
     onset: float = 0.0  # cm over which the stop's force rises smoothly
 
@@ -104,15 +103,14 @@ class Model:
     gravity: np.ndarray  # (3,) cm/s^2
     fixed: np.ndarray  # (N,3) bool
     pattern: BandPattern
-    cyl_op: sp.csr_matrix  # (C,6,6) element blocks -> flat storage (BandPattern.block_operator)
-    brick_op: sp.csr_matrix  # (B,24,24) blocks -> flat storage
-    mass_matrix: object  # SystemMatrix of M
+    tangent_op: sp.csr_matrix  # element blocks -> flat storage: cylinders (C,6,6), bricks (B,24,24), segments (S,6,6)
+    mass_flat: np.ndarray  # M in flat storage (BandPattern.unpack)
+    guide_flat: np.ndarray  # the condyle guide's constant stiffness in flat storage
     scatter: sp.csr_matrix  # (N, C): node force = scatter @ (T n)
     options: SolverOptions = field(default_factory=SolverOptions)
     node_sets: dict = field(default_factory=dict)
     names: dict = field(default_factory=dict)
     muscles: MuscleSet | None = None
-    seg_op: sp.csr_matrix | None = None  # (S,6,6) blocks -> flat storage
     groups: dict = field(default_factory=dict)  # group -> {muscle: share}
     guide: Guide | None = None
     contact: ContactModel | None = None
@@ -235,22 +233,23 @@ def _finish(mesh: Mesh, rest: np.ndarray, cyl: CylinderSet, link_mass: np.ndarra
     slaves = None if carried is None else (carried.nodes, carried.masters, carried.weights)
     pattern = band_pattern(n, all_pairs, fixed, n_core, slaves)
     cyl_op = pattern.block_operator(np.column_stack([cyl.i, cyl.j]))
-    brick_op = pattern.block_operator(mesh.bricks)
+    ops = [cyl_op, pattern.block_operator(mesh.bricks)]
+    if ms is not None:
+        ops.append(pattern.block_operator(np.column_stack([ms.seg_i, ms.seg_j])))
     mblock = np.kron(np.array([[2.0, 1.0], [1.0, 2.0]]), np.eye(3))[None] * (link_mass / 6.0)[:, None, None]
-    mass_matrix = pattern.assemble(cyl_op, mblock)
+    mass_flat = cyl_op @ mblock.ravel()
+    guide_flat = np.zeros(pattern.size)
     ncyl = len(cyl.i)
     scatter = sp.csr_matrix((np.concatenate([np.ones(ncyl), -np.ones(ncyl)]),
                              (np.concatenate([cyl.i, cyl.j]), np.concatenate([np.arange(ncyl)] * 2))), shape=(n, ncyl))
-    if ms is not None:
-        extra["seg_op"] = pattern.block_operator(np.column_stack([ms.seg_i, ms.seg_j]))
     guide = extra.pop("guide_spec", None)
     if guide is not None:
         nodes, origin, normals, k, path, onset = guide
-        extra["guide"] = Guide(nodes=nodes, origin=origin, normals=normals, stiffness=k,
-                               operator=pattern.diagonal_operator(nodes), path=path, onset=onset)
+        extra["guide"] = Guide(nodes=nodes, origin=origin, normals=normals, stiffness=k, path=path, onset=onset)
+        guide_flat = pattern.diagonal_operator(nodes) @ (k * np.einsum("gmi,gmj->gij", normals, normals)).ravel()
     return Model(mesh=mesh, rest=rest, cyl=cyl, bricks=mesh.bricks, brick_v0=v0,
                  kappa=kappa, mass=mass, node_mass=node_mass, gravity=np.array([0.0, -gravity, 0.0]), fixed=fixed,
-                 pattern=pattern, cyl_op=cyl_op, brick_op=brick_op, mass_matrix=mass_matrix,
+                 pattern=pattern, tangent_op=sp.hstack(ops, format="csr"), mass_flat=mass_flat, guide_flat=guide_flat,
                  scatter=scatter, options=solver_options(sim), **extra)
 
 

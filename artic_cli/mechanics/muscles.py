@@ -23,19 +23,29 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from . import elements, kernels
+
 FL_COEFFS = (22.5, 3.498, -14.718, 1.98, 0.858)  # Eq. (9), highest power first
 FL_RANGE = (-0.185, 0.49)
+FL_SLOPE_COEFFS = tuple(float(c) for c in np.polyder(FL_COEFFS))
+
+
+def _polyval(coeffs, e: np.ndarray) -> np.ndarray:
+    out = np.full_like(e, coeffs[0])
+    for c in coeffs[1:]:
+        out = out * e + c
+    return out
 
 
 def force_length(strain: np.ndarray) -> np.ndarray:
     """Eq. (9) normalised to 1 at rest length; zero outside its validity range."""
-    f = np.polyval(FL_COEFFS, strain) / FL_COEFFS[-1]
+    f = _polyval(FL_COEFFS, strain) / FL_COEFFS[-1]
     return np.where((strain > FL_RANGE[0]) & (strain < FL_RANGE[1]), np.maximum(f, 0.0), 0.0)
 
 
 def force_length_slope(strain: np.ndarray) -> np.ndarray:
     """d fL / d strain of :func:`force_length` (zero where fL is zero)."""
-    slope = np.polyval(np.polyder(FL_COEFFS), strain) / FL_COEFFS[-1]
+    slope = _polyval(FL_SLOPE_COEFFS, strain) / FL_COEFFS[-1]
     return np.where(force_length(strain) > 0, slope, 0.0)
 
 
@@ -103,10 +113,15 @@ class FibreState:
 def fibre_state(ms: MuscleSet, x: np.ndarray, activation: np.ndarray, sigma2_prev: np.ndarray,
                 strain_prev: np.ndarray, h: float) -> FibreState:
     """Tensions for positions ``x``, muscle forces ``activation`` (M,) in dyn, after a step ``h``."""
-    d = ms.diff @ x
-    length = np.sqrt((d * d).sum(axis=1))
-    n = d / length[:, None]
-    strain = (ms.seg_sum @ length) / ms.fibre_l0 - 1.0
+    if kernels.AVAILABLE and elements.USE_KERNELS:
+        n, length, total = kernels.fibre_geometry(np.ascontiguousarray(x), ms.seg_i, ms.seg_j, ms.seg_fibre,
+                                                  ms.n_fibres)
+    else:
+        d = ms.diff @ x
+        length = np.sqrt((d * d).sum(axis=1))
+        n = d / length[:, None]
+        total = ms.seg_sum @ length
+    strain = total / ms.fibre_l0 - 1.0
     sigma2 = (sigma2_prev + ms.k2 * (strain - strain_prev)) / (1.0 + h * ms.k2 / ms.b2) if h > 0 else sigma2_prev
     passive = ms.k1 * np.maximum(strain, 0.0) * strain + sigma2
     active = activation[ms.fibre_muscle] * ms.fibre_share * force_length(strain)
@@ -139,6 +154,8 @@ def length_gradients(ms: MuscleSet, fs: FibreState, fibres: np.ndarray, n_nodes:
 
 def muscle_forces(ms: MuscleSet, fs: FibreState) -> np.ndarray:
     """(N,3) nodal forces of all fibres."""
+    if kernels.AVAILABLE and elements.USE_KERNELS:
+        return kernels.fibre_forces(fs.n, fs.tension, ms.seg_i, ms.seg_j, ms.seg_fibre, ms.scatter.shape[0])
     return ms.scatter @ (fs.tension[ms.seg_fibre][:, None] * fs.n)
 
 
