@@ -159,17 +159,23 @@ def muscle_forces(ms: MuscleSet, fs: FibreState) -> np.ndarray:
     return ms.scatter @ (fs.tension[ms.seg_fibre][:, None] * fs.n)
 
 
+def fibre_lengths(ms: MuscleSet, x: np.ndarray) -> np.ndarray:
+    """(F,) length of every fibre, cm."""
+    if kernels.AVAILABLE and elements.USE_KERNELS:
+        return kernels.fibre_geometry(np.ascontiguousarray(x), ms.seg_i, ms.seg_j, ms.seg_fibre, ms.n_fibres)[2]
+    d = ms.diff @ x
+    return ms.seg_sum @ np.sqrt((d * d).sum(axis=1))
+
+
 def muscle_lengths(ms: MuscleSet, x: np.ndarray) -> np.ndarray:
     """(M,) mean fibre length of each muscle, cm."""
-    d = ms.diff @ x
-    fl = ms.seg_sum @ np.sqrt((d * d).sum(axis=1))
+    fl = fibre_lengths(ms, x)
     return np.bincount(ms.fibre_muscle, weights=fl * ms.fibre_share, minlength=len(ms.names))
 
 
 def muscle_tensions(ms: MuscleSet, x: np.ndarray, activation: np.ndarray, sigma2: np.ndarray) -> np.ndarray:
     """(M,) total force of each muscle (sum over its fibres), dyn, with the Maxwell state given."""
-    d = ms.diff @ x
-    strain = (ms.seg_sum @ np.sqrt((d * d).sum(axis=1))) / ms.fibre_l0 - 1.0
+    strain = fibre_lengths(ms, x) / ms.fibre_l0 - 1.0
     passive = ms.k1 * np.maximum(strain, 0.0) * strain + sigma2
     t = activation[ms.fibre_muscle] * ms.fibre_share * force_length(strain) + ms.fibre_area * passive
     return np.bincount(ms.fibre_muscle, weights=t, minlength=len(ms.names))
