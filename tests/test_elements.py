@@ -86,6 +86,7 @@ def test_compiled_kernels_give_the_numpy_numbers(art):
     """The numba loops (cylinders, bricks, guard) reproduce the numpy path, including a guarded corner."""
     from artic_cli.mechanics import elements, kernels
     from artic_cli.mechanics.integrator import internal_forces, tangent
+    from artic_cli.mechanics.muscles import fibre_state
 
     if not kernels.AVAILABLE:
         pytest.skip("numba not installed: only the numpy path runs")
@@ -95,12 +96,15 @@ def test_compiled_kernels_give_the_numpy_numbers(art):
     x[b[6]] = x[b[0]] + 0.2 * (x[b[6]] - x[b[0]])  # squash one brick so that the guard acts
     v = rng.normal(0, 1.0, x.shape)
     frame = elements.damping_frame(art.cyl, art.rest)
+    act = np.full(len(art.muscle_names), 2.0e5)
+    ms = art.muscles
     out = {}
     for flag in (False, True):
         elements.USE_KERNELS = flag
         try:
             f, cs, vol, grad, guard = internal_forces(art, x, v, frame)
-            k = tangent(art, cs, frame, grad, None, None, 0.005, 8e4, 367.0)
+            fs = fibre_state(ms, x, act, np.zeros(ms.n_fibres), np.zeros(ms.n_fibres), 0.005)
+            k = tangent(art, cs, frame, grad, fs, act, 0.005, 8e4, 367.0)
         finally:
             elements.USE_KERNELS = True
         out[flag] = (f, vol, grad, guard, k.band, k.b, k.c)
@@ -111,6 +115,39 @@ def test_compiled_kernels_give_the_numpy_numbers(art):
                 assert np.allclose(p, q, rtol=1e-10, atol=1e-12)
         else:
             assert np.allclose(a, c, rtol=1e-10, atol=1e-9 * np.abs(a).max())
+
+
+def test_node_level_assembly_is_t_transpose_k_t_of_the_element_blocks(art):
+    """Random symmetric element blocks (cylinders and links, bricks, fibre segments) summed per node pair and
+    folded to flat storage give the stored parts of T^T K T, K assembled densely element by element."""
+    from artic_cli.mechanics.assembly import pair_blocks, sparse_blocks
+
+    rng = np.random.default_rng(11)
+    n, asm, pat, ms = art.n_nodes, art.assembly, art.pattern, art.muscles
+
+    def sym(k):
+        a = rng.normal(size=(k, 3, 3))
+        return a + a.transpose(0, 2, 1)
+
+    k_cyl, k_seg = sym(len(art.cyl.i)), sym(len(ms.seg_i))
+    grad, w = rng.normal(size=(len(art.bricks), 8, 3)), rng.uniform(0.5, 2.0, len(art.bricks))
+    blocks = asm.blocks(n, (art.cyl.i, art.cyl.j), k_cyl, art.bricks, grad, w, (ms.seg_i, ms.seg_j), k_seg)
+    mat = pat.unpack(asm.operator @ blocks.ravel())
+    g = grad.reshape(len(w), 24)
+    dense = (sparse_blocks(np.column_stack([art.cyl.i, art.cyl.j]), pair_blocks(k_cyl), n)
+             + sparse_blocks(art.bricks, w[:, None, None] * g[:, :, None] * g[:, None, :], n)
+             + sparse_blocks(np.column_stack([ms.seg_i, ms.seg_j]), pair_blocks(k_seg), n))
+    t = pat.reduce.toarray()
+    want = t.T @ dense.toarray() @ t
+    nc, u = pat.n_core, pat.u
+    i, j = np.triu_indices(nc)
+    inside = j - i <= u
+    assert np.abs(want[:nc, :nc][np.abs(np.subtract.outer(np.arange(nc), np.arange(nc))) > u]).max() == 0.0
+    scale = np.abs(want).max()
+    assert np.allclose(mat.band[u + i[inside] - j[inside], j[inside]], want[i[inside], j[inside]], atol=1e-12 * scale)
+    assert np.allclose(mat.b, want[:nc, nc:], atol=1e-12 * scale)
+    assert np.allclose(mat.c, want[nc:, nc:], atol=1e-12 * scale)
+    assert len(art.carried.nodes) > 0 and pat.n_border > 0  # folding and border were exercised
 
 
 def test_compiled_fibre_and_wall_kernels_give_the_numpy_numbers(art):

@@ -78,6 +78,22 @@ class BandPattern:
         """Operator for 3x3 blocks on the diagonal at ``nodes`` (E,)."""
         return self.block_operator(nodes[:, None])
 
+    def node_block_operator(self, pairs: np.ndarray, n_nodes: int) -> sp.csr_matrix:
+        """(size, 9 (P + N)) operator taking node-level blocks to flat storage.
+
+        The blocks (P + N, 3, 3) are the matrix's 3x3 block at (row i, column j) of each node pair
+        (i < j) of ``pairs`` (P,2) (the block at (j, i) is its transpose), then each node's diagonal
+        block.  Element matrices are summed into these blocks first, so that the folding of carried
+        points and the choice of stored entries is paid once per node pair, not once per element."""
+        p = len(pairs)
+        pair_op = self.block_operator(pairs)  # (size, 36 P): dense 6x6 blocks over (i, j)
+        a, b = np.meshgrid(np.arange(3), np.arange(3), indexing="ij")
+        col = (9 * np.arange(p)[:, None] + (3 * a + b).ravel()).ravel()  # block entry (p, a, b)
+        upper = (36 * np.arange(p)[:, None] + (6 * a + 3 + b).ravel()).ravel()  # element entry (a, 3 + b)
+        lower = (36 * np.arange(p)[:, None] + (6 * (3 + b) + a).ravel()).ravel()  # its transpose (3 + b, a)
+        pick = sp.csr_matrix((np.ones(2 * col.size), (np.r_[upper, lower], np.r_[col, col])), shape=(36 * p, 9 * p))
+        return sp.hstack([pair_op @ pick, self.diagonal_operator(np.arange(n_nodes))], format="csr")
+
     def _flat(self, r: np.ndarray, c: np.ndarray) -> np.ndarray:
         """Flat storage index of matrix entry (r, c), -1 where it is not stored."""
         nc, nb = self.n_core, self.n_border
@@ -259,11 +275,89 @@ def factorize(mat: SystemMatrix, key: tuple) -> BandFactor:
     if mat.c.size == 0:
         return BandFactor(cb=cb, key=key)
     w = np.zeros_like(mat.b)
-    coupled = np.flatnonzero(np.any(mat.b != 0.0, axis=0))  # border dofs with no link to the core: W = 0
-    w[:, coupled], info = dtbtrs(cb, mat.b[:, coupled], uplo="U", trans="T")
+    # U^T is lower triangular, so column c of W is zero above the first core row that B couples to c:
+    # solve from there on (border dofs with no link to the core have W = 0)
+    nz = mat.b != 0.0
+    first = np.where(nz.any(axis=0), nz.argmax(axis=0), mat.b.shape[0])
+    for k in np.unique(first[first < mat.b.shape[0]]):
+        cols = np.flatnonzero(first == k)
+        w[k:, cols], info = dtbtrs(cb[:, k:], mat.b[k:, cols], uplo="U", trans="T")
+        _check(info, "banded solve")
     ls, info = dpotrf(mat.c - w.T @ w, lower=1)
     _check(info, "Schur complement")
     return BandFactor(cb=cb, key=key, w=w, ls=ls)
+
+
+@dataclass(frozen=True)
+class NodeAssembly:
+    """Where element blocks land: the node pairs (i < j) joined by any element, each element's pair,
+    and the operator from node-level blocks (P + N, 3, 3) to the pattern's flat storage."""
+
+    pairs: np.ndarray  # (P,2)
+    cyl_pair: np.ndarray  # (C,) pair of each cylinder or link
+    brick_pair: np.ndarray  # (B,8,8) pair of each two corners of a brick, -1 on the diagonal
+    seg_pair: np.ndarray  # (S,) pair of each fibre segment
+    operator: sp.csr_matrix  # (size, 9 (P + N))
+
+    @property
+    def n_pairs(self) -> int:
+        return len(self.pairs)
+
+    def blocks(self, n_nodes: int, cyl: tuple, k_cyl: np.ndarray, bricks: np.ndarray, grad: np.ndarray,
+               w: np.ndarray, seg: tuple, k_seg: np.ndarray) -> np.ndarray:
+        """Node-level blocks (numpy; :func:`..kernels.node_blocks` computes the same in one loop):
+        two-node elements (i, j) with 3x3 blocks k give k on both diagonals and -k on their pair;
+        bricks give w g_a g_b^T for every two corners (``grad`` (B,8,3))."""
+        p = self.n_pairs
+        out = np.zeros((p + n_nodes, 3, 3))
+        for (i, j), pair, k in ((cyl, self.cyl_pair, k_cyl), (seg, self.seg_pair, k_seg)):
+            if len(k) == 0:
+                continue
+            np.add.at(out, p + i, k)
+            np.add.at(out, p + j, k)
+            np.add.at(out, pair, -k)
+        if len(grad):
+            gg = w[:, None, None, None, None] * grad[:, :, None, :, None] * grad[:, None, :, None, :]  # (B,8,8,3,3)
+            na, nb = bricks[:, :, None], bricks[:, None, :]
+            upper = np.broadcast_to(na < nb, gg.shape[:3])
+            diag = np.broadcast_to(np.eye(8, dtype=bool), gg.shape[:3])
+            np.add.at(out, self.brick_pair[upper], gg[upper])
+            np.add.at(out, p + np.broadcast_to(na, gg.shape[:3])[diag], gg[diag])
+        return out
+
+
+def node_assembly(pattern: "BandPattern", n_nodes: int, cyl_edges: np.ndarray, bricks: np.ndarray,
+                  seg_edges: np.ndarray) -> NodeAssembly:
+    """Node pairs and the operator for two-node elements (cylinders, links: ``cyl_edges`` (C,2); fibre
+    segments: ``seg_edges`` (S,2)) and bricks (B,8)."""
+    corner_a = np.broadcast_to(bricks[:, :, None], (len(bricks), 8, 8))
+    corner_b = np.broadcast_to(bricks[:, None, :], (len(bricks), 8, 8))
+    pairs = node_pairs(np.vstack([cyl_edges, seg_edges, np.column_stack([corner_a.ravel(), corner_b.ravel()])]))
+    return NodeAssembly(pairs=pairs, cyl_pair=pair_index(pairs, cyl_edges[:, 0], cyl_edges[:, 1]),
+                        brick_pair=pair_index(pairs, corner_a.ravel(), corner_b.ravel()).reshape(corner_a.shape),
+                        seg_pair=pair_index(pairs, seg_edges[:, 0], seg_edges[:, 1]),
+                        operator=pattern.node_block_operator(pairs, n_nodes))
+
+
+def node_pairs(edges: np.ndarray) -> np.ndarray:
+    """(P,2) the distinct node pairs (i < j) among ``edges`` (E,2)."""
+    e = np.sort(np.asarray(edges, dtype=np.int64), axis=1)
+    return np.unique(e[e[:, 0] != e[:, 1]], axis=0)
+
+
+def pair_index(pairs: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row of ``pairs`` holding each (a, b) in either order; -1 where a == b.  Every other pair must exist."""
+    a, b = np.asarray(a, dtype=np.int64), np.asarray(b, dtype=np.int64)
+    scale = int(pairs.max(initial=0)) + 1
+    keys = pairs[:, 0] * scale + pairs[:, 1]
+    lo, hi = np.minimum(a, b), np.maximum(a, b)
+    q = lo * scale + hi
+    idx = np.searchsorted(keys, q)
+    same = a == b
+    found = (idx < len(keys)) & (keys[np.minimum(idx, len(keys) - 1)] == q)
+    if not (found | same).all():
+        raise ValueError("an element joins two nodes that are not a listed pair")
+    return np.where(same, -1, idx)
 
 
 def sparse_blocks(nodes: np.ndarray, blocks: np.ndarray, n_nodes: int) -> sp.csr_matrix:

@@ -23,7 +23,7 @@ import numpy as np
 
 from ..errors import ArticError
 from . import elements, kernels
-from .assembly import add_low_rank, factorize, pair_blocks
+from .assembly import add_low_rank, factorize
 from .contact import ContactPlanes, contact_planes, enforce
 from .model import Control, Model, State
 from .penalty import ramp
@@ -120,33 +120,34 @@ def tangent(model: Model, cs: elements.CylinderState, frame: elements.DampingFra
     """The banded part of the Newton matrix: mass, cylinders and links, volume, fibres' own blocks, guide."""
     # geometric stiffness T / l with its sign: compressed cylinders soften sideways (the mass term keeps
     # the matrix positive definite at these loads; a failed factorisation falls back to clipping)
-    axial = elements.axial_stiffness(model.cyl, cs)
+    cyl, asm = model.cyl, model.assembly
+    axial = elements.axial_stiffness(cyl, cs)
+    nb = len(model.brick_v0)
+    grad = np.zeros((0, 8, 3)) if grad is None else grad.reshape(nb, 8, 3)
+    w = model.kappa / model.brick_v0
+    ms = model.muscles
+    if fs is not None:
+        t = np.maximum(fs.tension[ms.seg_fibre], 0.0) / fs.seg_length
+        nn = fs.n[:, :, None] * fs.n[:, None, :]
+        kf = fibre_stiffness(ms, fs, act, h)
+        soft = np.where(kf < _RANK_ONE_STIFFNESS, kf * ms.fibre_l0, 0.0)  # split in series
+        k_seg = t[:, None, None] * (_EYE - nn) + (soft[ms.seg_fibre] / ms.seg_l0)[:, None, None] * nn
+        seg = (ms.seg_i, ms.seg_j)
+    else:
+        k_seg = np.zeros((0, 3, 3))
+        seg = (np.zeros(0, dtype=np.int64),) * 2
     if kernels.AVAILABLE and elements.USE_KERNELS:
-        blocks = kernels.cylinder_blocks(cs.n, cs.length, cs.elastic, axial, frame.n, frame.c, c_v, signed_geometry)
+        blocks = kernels.node_blocks(cs.n, cs.length, cs.elastic, axial, frame.n, frame.c, c_v, signed_geometry,
+                                     cyl.i, cyl.j, asm.cyl_pair, model.bricks, asm.brick_pair, grad, w,
+                                     seg[0], seg[1], asm.seg_pair if fs is not None else seg[0], k_seg,
+                                     asm.n_pairs, model.n_nodes)
     else:
         k_geo = (cs.elastic if signed_geometry else np.maximum(cs.elastic, 0.0)) / cs.length
         k_nn = np.maximum(axial, 0.0) - k_geo
         k3 = (k_nn[:, None, None] * (cs.n[:, :, None] * cs.n[:, None, :]) + k_geo[:, None, None] * _EYE
               + (c_v * frame.c)[:, None, None] * (frame.n[:, :, None] * frame.n[:, None, :]))
-        blocks = pair_blocks(k3)
-    vals = [blocks.ravel()]
-    nb = len(model.brick_v0)
-    if grad is not None:
-        g = grad.reshape(nb, 24)
-        w = model.kappa / model.brick_v0
-        vals.append((w[:, None, None] * g[:, :, None] * g[:, None, :]).ravel())
-    else:
-        vals.append(np.zeros(nb * 576))
-    if fs is not None:
-        t = np.maximum(fs.tension[model.muscles.seg_fibre], 0.0) / fs.seg_length
-        nn = fs.n[:, :, None] * fs.n[:, None, :]
-        kf = fibre_stiffness(model.muscles, fs, act, h)
-        soft = np.where(kf < _RANK_ONE_STIFFNESS, kf * model.muscles.fibre_l0, 0.0)  # split in series
-        kk = t[:, None, None] * (_EYE - nn) + (soft[model.muscles.seg_fibre] / model.muscles.seg_l0)[:, None, None] * nn
-        vals.append(pair_blocks(kk).ravel())
-    elif model.muscles is not None:
-        vals.append(np.zeros(len(model.muscles.seg_i) * 36))
-    flat = model.tangent_op @ np.concatenate(vals)
+        blocks = asm.blocks(model.n_nodes, (cyl.i, cyl.j), k3, model.bricks, grad, w, seg, k_seg)
+    flat = asm.operator @ blocks.ravel()
     flat += c_a * model.mass_flat
     flat += model.guide_flat
     return model.pattern.unpack(flat)

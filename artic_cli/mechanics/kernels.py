@@ -87,24 +87,54 @@ def cylinder_forces(n, elastic, ci, cj, frame_n, frame_c, v, n_nodes, with_dampi
 
 
 @njit(cache=True, fastmath=False)
-def cylinder_blocks(n, length, elastic, axial, frame_n, frame_c, c_v, signed):
-    """(C,6,6) tangent blocks [[k, -k], [-k, k]] with k = (K_ax - T/l) n n^T + T/l I + c_v c n0 n0^T."""
-    c = len(length)
-    out = np.empty((c, 6, 6))
-    for k in range(c):
+def node_blocks(n, length, elastic, axial, frame_n, frame_c, c_v, signed, ci, cj, cyl_pair,
+                bricks, brick_pair, grad, brick_w, seg_i, seg_j, seg_pair, seg_k, n_pairs, n_nodes):
+    """Node-level tangent blocks (P + N, 3, 3): node pairs (i < j), then diagonals.
+
+    Cylinders: k = (K_ax - T/l) n n^T + T/l I + c_v c n0 n0^T on both diagonals, -k on their pair.
+    Bricks: w g_a g_b^T for every corner pair (Gauss-Newton volume tangent, ``grad`` (B,8,3), may be
+    empty).  Fibre segments: their own 3x3 ``seg_k`` like cylinders."""
+    out = np.zeros((n_pairs + n_nodes, 3, 3))
+    k3 = np.empty((3, 3))
+    for k in range(len(length)):
         t = elastic[k] if signed else max(elastic[k], 0.0)
         kg = t / length[k]
         kn = max(axial[k], 0.0) - kg
         cv = c_v * frame_c[k]
         for p in range(3):
             for q in range(3):
-                val = kn * n[k, p] * n[k, q] + cv * frame_n[k, p] * frame_n[k, q]
-                if p == q:
-                    val += kg
-                out[k, p, q] = val
-                out[k, p + 3, q + 3] = val
-                out[k, p, q + 3] = -val
-                out[k, p + 3, q] = -val
+                k3[p, q] = kn * n[k, p] * n[k, q] + cv * frame_n[k, p] * frame_n[k, q]
+            k3[p, p] += kg
+        a, b, m = n_pairs + ci[k], n_pairs + cj[k], cyl_pair[k]
+        for p in range(3):
+            for q in range(3):
+                out[a, p, q] += k3[p, q]
+                out[b, p, q] += k3[p, q]
+                out[m, p, q] -= k3[p, q]
+    for e in range(grad.shape[0]):
+        w = brick_w[e]
+        for a in range(8):
+            na = bricks[e, a]
+            for b in range(8):
+                nb = bricks[e, b]
+                if na < nb:
+                    m = brick_pair[e, a, b]
+                elif a == b:
+                    m = n_pairs + na
+                else:
+                    continue
+                for p in range(3):
+                    wp = w * grad[e, a, p]
+                    for q in range(3):
+                        out[m, p, q] += wp * grad[e, b, q]
+    for k in range(len(seg_pair)):
+        a, b, m = n_pairs + seg_i[k], n_pairs + seg_j[k], seg_pair[k]
+        for p in range(3):
+            for q in range(3):
+                v = seg_k[k, p, q]
+                out[a, p, q] += v
+                out[b, p, q] += v
+                out[m, p, q] -= v
     return out
 
 

@@ -27,7 +27,7 @@ from ..geometry.anatomy import JAW_MUSCLES, LINK_KINDS, TONGUE_MUSCLES, Body, bu
 from ..geometry.hexahedra import corner_jacobians, volumes
 from ..geometry.mesh import Mesh
 from ..geometry.wall import WallSurface
-from .assembly import BandFactor, BandPattern, band_pattern
+from .assembly import BandFactor, BandPattern, NodeAssembly, band_pattern, node_assembly
 from .calibration import calibrate
 from .contact import ContactModel, contact_model
 from .elements import CylinderSet
@@ -103,7 +103,7 @@ class Model:
     gravity: np.ndarray  # (3,) cm/s^2
     fixed: np.ndarray  # (N,3) bool
     pattern: BandPattern
-    tangent_op: sp.csr_matrix  # element blocks -> flat storage: cylinders (C,6,6), bricks (B,24,24), segments (S,6,6)
+    assembly: NodeAssembly  # node pairs and the operator from node-level blocks to flat storage
     mass_flat: np.ndarray  # M in flat storage (BandPattern.unpack)
     guide_flat: np.ndarray  # the condyle guide's constant stiffness in flat storage
     scatter: sp.csr_matrix  # (N, C): node force = scatter @ (T n)
@@ -232,12 +232,14 @@ def _finish(mesh: Mesh, rest: np.ndarray, cyl: CylinderSet, link_mass: np.ndarra
     carried = extra.get("carried")
     slaves = None if carried is None else (carried.nodes, carried.masters, carried.weights)
     pattern = band_pattern(n, all_pairs, fixed, n_core, slaves)
-    cyl_op = pattern.block_operator(np.column_stack([cyl.i, cyl.j]))
-    ops = [cyl_op, pattern.block_operator(mesh.bricks)]
-    if ms is not None:
-        ops.append(pattern.block_operator(np.column_stack([ms.seg_i, ms.seg_j])))
-    mblock = np.kron(np.array([[2.0, 1.0], [1.0, 2.0]]), np.eye(3))[None] * (link_mass / 6.0)[:, None, None]
-    mass_flat = cyl_op @ mblock.ravel()
+    cyl_edges = np.column_stack([cyl.i, cyl.j])
+    seg_edges = np.column_stack([ms.seg_i, ms.seg_j]) if ms is not None else np.zeros((0, 2), dtype=np.int64)
+    asm = node_assembly(pattern, n, cyl_edges, mesh.bricks, seg_edges)
+    eye = np.broadcast_to(np.eye(3), (len(cyl.i), 3, 3))
+    mblocks = asm.blocks(n, (cyl.i, cyl.j), (link_mass / 3.0)[:, None, None] * eye, mesh.bricks, np.zeros((0, 8, 3)),
+                         np.zeros(0), (seg_edges[:, 0], seg_edges[:, 1]), np.zeros((len(seg_edges), 3, 3)))
+    mblocks[: asm.n_pairs] *= -0.5  # consistent mass: m/3 on the diagonal, m/6 between the two nodes
+    mass_flat = asm.operator @ mblocks.ravel()
     guide_flat = np.zeros(pattern.size)
     ncyl = len(cyl.i)
     scatter = sp.csr_matrix((np.concatenate([np.ones(ncyl), -np.ones(ncyl)]),
@@ -249,7 +251,7 @@ def _finish(mesh: Mesh, rest: np.ndarray, cyl: CylinderSet, link_mass: np.ndarra
         guide_flat = pattern.diagonal_operator(nodes) @ (k * np.einsum("gmi,gmj->gij", normals, normals)).ravel()
     return Model(mesh=mesh, rest=rest, cyl=cyl, bricks=mesh.bricks, brick_v0=v0,
                  kappa=kappa, mass=mass, node_mass=node_mass, gravity=np.array([0.0, -gravity, 0.0]), fixed=fixed,
-                 pattern=pattern, tangent_op=sp.hstack(ops, format="csr"), mass_flat=mass_flat, guide_flat=guide_flat,
+                 pattern=pattern, assembly=asm, mass_flat=mass_flat, guide_flat=guide_flat,
                  scatter=scatter, options=solver_options(sim), **extra)
 
 
