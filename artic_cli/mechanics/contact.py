@@ -14,7 +14,9 @@ a step more than ``tolerance`` outside the wall.
 
 The mandible's part of the wall moves with the jaw: closest points are
 found in the jaw's rest frame (inverse of the rigid motion of the mandible
-nodes, Kabsch), where that part is fixed, so both KD-trees are built once.
+nodes, Kabsch), where that part is fixed.  Closest triangles come from
+voxel grids built once, whose candidate lists are exact (see
+:class:`CandidateGrid`).
 """
 
 from __future__ import annotations
@@ -30,19 +32,82 @@ from . import elements, kernels
 
 
 @dataclass(frozen=True)
+class CandidateGrid:
+    """A voxel grid that lists, for every voxel, each triangle that can hold the closest wall point of a
+    point inside it.  Exact: with c the voxel's centre and r its half diagonal, the closest triangle T of
+    any point p of the voxel has d(c, T) <= d(p, T) + r <= d(p, T*) + r <= d(c, T*) + 2 r for the triangle
+    T* closest to c, so every triangle within 2 r of the smallest centre distance is listed.  Points
+    outside the grid search all triangles."""
+
+    lo: np.ndarray  # (3,) cm, the grid's lower corner
+    spacing: float  # cm
+    dims: np.ndarray  # (3,) voxels along x, y, z
+    offsets: np.ndarray  # (V+1,) voxel v lists cands[offsets[v]:offsets[v + 1]]
+    cands: np.ndarray  # triangle indices
+    tris: np.ndarray  # all triangles of this part
+
+    def as_tuple(self) -> tuple:
+        return self.lo, float(self.spacing), self.dims, self.offsets, self.cands, self.tris
+
+    def candidates(self, p: np.ndarray) -> np.ndarray:
+        """Triangle indices to search for point p (3,)."""
+        cell = np.floor((p - self.lo) / self.spacing).astype(np.int64)
+        if (cell < 0).any() or (cell >= self.dims).any():
+            return self.tris
+        v = (cell[0] * self.dims[1] + cell[1]) * self.dims[2] + cell[2]
+        return self.cands[self.offsets[v]: self.offsets[v + 1]]
+
+
+def candidate_grid(corners: np.ndarray, tris: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+                   spacing: float = 0.25) -> CandidateGrid:
+    """The exact candidate lists of :class:`CandidateGrid` for triangles ``tris`` over the box [lo, hi]."""
+    lo = np.asarray(lo, dtype=float)
+    dims = np.maximum(np.ceil((np.asarray(hi) - lo) / spacing), 1).astype(np.int64)
+    axes = [lo[a] + spacing * (np.arange(dims[a]) + 0.5) for a in range(3)]
+    centres = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+    tri_centre = corners[tris].mean(axis=1)
+    reach = float(np.linalg.norm(corners[tris] - tri_centre[:, None], axis=2).max())  # centre to farthest corner
+    slack = spacing * np.sqrt(3.0)  # the voxel's diameter, 2 r
+    tree = cKDTree(tri_centre)
+    _, near = tree.query(centres, k=min(4, len(tris)))
+    near = near.reshape(len(centres), -1)
+    upper = _distances(np.repeat(centres, near.shape[1], axis=0), tris[near.ravel()], corners)
+    bound = upper.reshape(near.shape).min(axis=1)  # >= the smallest distance from each centre
+    # every triangle within bound + 2 r of a centre has its own centre within bound + 2 r + reach of it
+    ball = tree.query_ball_point(centres, bound + slack + reach)
+    counts = np.array([len(b) for b in ball])
+    point = np.repeat(np.arange(len(centres)), counts)
+    tri = tris[np.concatenate([np.asarray(b, dtype=np.int64) for b in ball])]
+    d = _distances(centres[point], tri, corners)
+    starts = np.r_[0, np.cumsum(counts)[:-1]]
+    keep = d <= np.minimum.reduceat(d, starts)[point] + slack + 1e-9
+    point, tri = point[keep], tri[keep]
+    order = np.lexsort((tri, point))
+    offsets = np.r_[0, np.cumsum(np.bincount(point, minlength=len(centres)))]
+    return CandidateGrid(lo=lo, spacing=float(spacing), dims=dims, offsets=offsets, cands=tri[order],
+                         tris=np.asarray(tris, dtype=np.int64))
+
+
+def _distances(p: np.ndarray, tri: np.ndarray, corners: np.ndarray) -> np.ndarray:
+    """Distance from each point p (K,3) to its triangle tri (K,)."""
+    if kernels.AVAILABLE:
+        return kernels.triangle_distances(np.ascontiguousarray(p), tri, np.ascontiguousarray(corners))
+    c = corners[tri]
+    q = closest_on_triangles(p, c[:, 0], c[:, 1], c[:, 2])
+    return np.linalg.norm(p - q, axis=1)
+
+
+@dataclass(frozen=True)
 class ContactModel:
     nodes: np.ndarray  # (P,) tongue nodes that may touch the wall
     wall: WallSurface
-    fixed_tris: np.ndarray  # triangles of the skull's wall parts
-    jaw_tris: np.ndarray  # triangles of the mandible part
-    fixed_tree: cKDTree
-    jaw_tree: cKDTree
+    fixed_grid: CandidateGrid  # the skull's wall parts
+    jaw_grid: CandidateGrid  # the mandible part, in the jaw's rest frame
     jaw_nodes: np.ndarray  # mandible nodes defining the jaw's rigid motion
     jaw_rest: np.ndarray  # their rest positions
     stiffness: float  # dyn/cm
     tolerance: float  # cm
     margin: float = 0.5  # cm: nodes closer than this get a plane for the step
-    neighbours: int = 6
 
     @cached_property
     def corners(self) -> np.ndarray:
@@ -50,13 +115,18 @@ class ContactModel:
         return np.ascontiguousarray(self.wall.vertices[self.wall.triangles])
 
 
-def contact_model(wall: WallSurface, nodes: np.ndarray, jaw_nodes: np.ndarray, jaw_rest: np.ndarray,
-                  stiffness: float, tolerance: float) -> ContactModel:
-    centre = wall.vertices[wall.triangles].mean(axis=1)
+GRID_REACH = 1.5  # cm: the candidate grids cover the contact nodes' rest positions and this much around them
+
+
+def contact_model(wall: WallSurface, nodes: np.ndarray, points: np.ndarray, jaw_nodes: np.ndarray,
+                  jaw_rest: np.ndarray, stiffness: float, tolerance: float) -> ContactModel:
+    """Contact of the tongue nodes ``nodes`` (rest positions ``points``) with the wall."""
+    corners = wall.vertices[wall.triangles]
     jaw = np.flatnonzero(wall.part == PARTS.index("mandible"))
     fixed = np.flatnonzero(wall.part != PARTS.index("mandible"))
-    return ContactModel(nodes=np.asarray(nodes), wall=wall, fixed_tris=fixed, jaw_tris=jaw,
-                        fixed_tree=cKDTree(centre[fixed]), jaw_tree=cKDTree(centre[jaw]), jaw_nodes=jaw_nodes,
+    lo, hi = points.min(axis=0) - GRID_REACH, points.max(axis=0) + GRID_REACH
+    return ContactModel(nodes=np.asarray(nodes), wall=wall, fixed_grid=candidate_grid(corners, fixed, lo, hi),
+                        jaw_grid=candidate_grid(corners, jaw, lo, hi), jaw_nodes=jaw_nodes,
                         jaw_rest=jaw_rest, stiffness=stiffness, tolerance=tolerance)
 
 
@@ -102,25 +172,16 @@ def closest_on_triangles(p: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndar
     return out
 
 
-def _nearest(cm: ContactModel, p: np.ndarray, tree: cKDTree, tris: np.ndarray):
-    """Closest wall point, its triangle normal and the signed distance along it."""
-    k = min(cm.neighbours, len(tris))
-    _, idx = tree.query(p, k=k)
-    idx = idx.reshape(len(p), k)
-    if kernels.AVAILABLE and elements.USE_KERNELS:
-        return kernels.nearest_on_triangles(np.ascontiguousarray(p), tris[idx], cm.corners, cm.wall.normals)
-    t = cm.wall.triangles[tris[idx]]  # (P,k,3)
-    v = cm.wall.vertices
-    pp = np.repeat(p, k, axis=0)
-    q = closest_on_triangles(pp, v[t[..., 0]].reshape(-1, 3), v[t[..., 1]].reshape(-1, 3),
-                             v[t[..., 2]].reshape(-1, 3)).reshape(len(p), k, 3)
-    dist = np.linalg.norm(q - p[:, None], axis=2)
-    best = dist.argmin(axis=1)
-    rows = np.arange(len(p))
-    q = q[rows, best]
-    n = cm.wall.normals[tris[idx[rows, best]]]
-    g = ((p - q) * n).sum(axis=1)
-    return q, n, g
+def _nearest(cm: ContactModel, p: np.ndarray, grid: CandidateGrid):
+    """Closest wall point, its triangle normal and the signed distance along it (numpy)."""
+    q, n = np.empty_like(p), np.empty_like(p)
+    for i, pi in enumerate(p):
+        tris = grid.candidates(pi)
+        c = cm.corners[tris]
+        near = closest_on_triangles(np.broadcast_to(pi, (len(tris), 3)), c[:, 0], c[:, 1], c[:, 2])
+        best = np.argmin(((near - pi) ** 2).sum(axis=1))
+        q[i], n[i] = near[best], cm.wall.normals[tris[best]]
+    return q, n, ((p - q) * n).sum(axis=1)
 
 
 @dataclass(frozen=True)
@@ -146,10 +207,14 @@ def wall_query(cm: ContactModel, x: np.ndarray, nodes: np.ndarray | None = None)
     """Closest wall point, normal and signed gap (> 0: beyond the wall) for contact nodes."""
     nodes = cm.nodes if nodes is None else nodes
     p = x[nodes]
-    q1, n1, g1 = _nearest(cm, p, cm.fixed_tree, cm.fixed_tris)
+    if kernels.AVAILABLE and elements.USE_KERNELS:
+        r, t = kernels.rigid_motion(cm.jaw_rest, np.ascontiguousarray(x[cm.jaw_nodes]))
+        return kernels.wall_nearest(p, (p - t) @ r, cm.fixed_grid.as_tuple(), cm.jaw_grid.as_tuple(), cm.corners,
+                                    cm.wall.normals, r, t)
+    q1, n1, g1 = _nearest(cm, p, cm.fixed_grid)
     r, t = rigid_motion(cm.jaw_rest, x[cm.jaw_nodes])
     pj = (p - t) @ r  # into the jaw's rest frame
-    q2, n2, g2 = _nearest(cm, pj, cm.jaw_tree, cm.jaw_tris)
+    q2, n2, g2 = _nearest(cm, pj, cm.jaw_grid)
     q2, n2 = q2 @ r.T + t, n2 @ r.T
     d1 = np.linalg.norm(p - q1, axis=1)
     d2 = np.linalg.norm(p - q2, axis=1)

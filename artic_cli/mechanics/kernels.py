@@ -274,26 +274,100 @@ def _closest_on_triangle(p, t):
 
 
 @njit(cache=True, fastmath=False)
-def nearest_on_triangles(p, candidates, corners, normals):
-    """For each point p (P,3), the closest point over its candidate triangles (P,k) (indices into
-    ``corners`` (T,3,3) and ``normals`` (T,3)): closest point (P,3), that triangle's normal (P,3) and the
-    signed distance along it (P,)."""
-    npt, k = candidates.shape
+def triangle_distances(p, tri, corners):
+    """Distance from each point p (K,3) to its triangle tri (K,) (corners (T,3,3))."""
+    d = np.empty(len(tri))
+    for k in range(len(tri)):
+        q0, q1, q2 = _closest_on_triangle(p[k], corners[tri[k]])
+        d[k] = np.sqrt((p[k, 0] - q0) ** 2 + (p[k, 1] - q1) ** 2 + (p[k, 2] - q2) ** 2)
+    return d
+
+
+@njit(cache=True, fastmath=False)
+def _nearest_in_grid(p, grid, corners, normals, q, n):
+    """Closest point q (3,) to p (3,) over the candidate triangles of p's voxel (all triangles outside the
+    grid; ``grid`` = :meth:`..contact.CandidateGrid.as_tuple`), and that triangle's normal n (3,)."""
+    lo, spacing, dims, offsets, cands, tris = grid
+    cell = 0
+    inside = True
+    for a in range(3):
+        c = int(np.floor((p[a] - lo[a]) / spacing))
+        if c < 0 or c >= dims[a]:
+            inside = False
+        cell = cell * dims[a] + c
+    ids = cands[offsets[cell]: offsets[cell + 1]] if inside else tris
+    best = np.inf
+    for m in range(len(ids)):
+        t = ids[m]
+        q0, q1, q2 = _closest_on_triangle(p, corners[t])
+        d = (p[0] - q0) ** 2 + (p[1] - q1) ** 2 + (p[2] - q2) ** 2
+        if d < best:
+            best = d
+            q[0], q[1], q[2] = q0, q1, q2
+            n[0], n[1], n[2] = normals[t, 0], normals[t, 1], normals[t, 2]
+
+
+@njit(cache=True, fastmath=False)
+def wall_nearest(p, pj, fixed_grid, jaw_grid, corners, normals, r, t):
+    """:func:`..contact.wall_query` for points p (P,3) (and pj, the same points in the jaw's rest frame):
+    the closer of the nearest skull point and the nearest mandible point (found in the rest frame, mapped
+    by x -> r x + t).  Returns closest points (P,3), normals (P,3), signed gaps (P,) and whether the
+    mandible won (P,)."""
+    npt = p.shape[0]
     q = np.empty((npt, 3))
     n = np.empty((npt, 3))
     g = np.empty(npt)
+    use_jaw = np.zeros(npt, dtype=np.bool_)
+    q1 = np.empty(3)
+    n1 = np.empty(3)
+    q2 = np.empty(3)
+    n2 = np.empty(3)
+    qw = np.empty(3)
+    nw = np.empty(3)
     for i in range(npt):
-        best = np.inf
-        for m in range(k):
-            t = candidates[i, m]
-            q0, q1, q2 = _closest_on_triangle(p[i], corners[t])
-            d = (p[i, 0] - q0) ** 2 + (p[i, 1] - q1) ** 2 + (p[i, 2] - q2) ** 2
-            if d < best:
-                best = d
-                q[i, 0], q[i, 1], q[i, 2] = q0, q1, q2
-                n[i] = normals[t]
-        g[i] = (p[i, 0] - q[i, 0]) * n[i, 0] + (p[i, 1] - q[i, 1]) * n[i, 1] + (p[i, 2] - q[i, 2]) * n[i, 2]
-    return q, n, g
+        _nearest_in_grid(p[i], fixed_grid, corners, normals, q1, n1)
+        _nearest_in_grid(pj[i], jaw_grid, corners, normals, q2, n2)
+        g1 = (p[i, 0] - q1[0]) * n1[0] + (p[i, 1] - q1[1]) * n1[1] + (p[i, 2] - q1[2]) * n1[2]
+        g2 = (pj[i, 0] - q2[0]) * n2[0] + (pj[i, 1] - q2[1]) * n2[1] + (pj[i, 2] - q2[2]) * n2[2]
+        for a in range(3):
+            qw[a] = q2[0] * r[a, 0] + q2[1] * r[a, 1] + q2[2] * r[a, 2] + t[a]
+            nw[a] = n2[0] * r[a, 0] + n2[1] * r[a, 1] + n2[2] * r[a, 2]
+        d1 = np.sqrt((p[i, 0] - q1[0]) ** 2 + (p[i, 1] - q1[1]) ** 2 + (p[i, 2] - q1[2]) ** 2)
+        d2 = np.sqrt((p[i, 0] - qw[0]) ** 2 + (p[i, 1] - qw[1]) ** 2 + (p[i, 2] - qw[2]) ** 2)
+        if d2 < d1:
+            use_jaw[i] = True
+            for a in range(3):
+                q[i, a], n[i, a] = qw[a], nw[a]
+            g[i] = g2
+        else:
+            for a in range(3):
+                q[i, a], n[i, a] = q1[a], n1[a]
+            g[i] = g1
+    return q, n, g, use_jaw
+
+
+@njit(cache=True, fastmath=False)
+def rigid_motion(rest, now):
+    """R, t with now ~ rest @ R.T + t (Kabsch), as :func:`..contact.rigid_motion`."""
+    m = rest.shape[0]
+    cr = np.zeros(3)
+    cn = np.zeros(3)
+    for i in range(m):
+        for a in range(3):
+            cr[a] += rest[i, a] / m
+            cn[a] += now[i, a] / m
+    h = np.zeros((3, 3))
+    for i in range(m):
+        for a in range(3):
+            for b in range(3):
+                h[a, b] += (rest[i, a] - cr[a]) * (now[i, b] - cn[b])
+    u, _, vt = np.linalg.svd(h)
+    d = np.sign(np.linalg.det(vt.T @ u.T))
+    for a in range(3):
+        vt[2, a] *= d
+    r = vt.T @ u.T
+    t = cn - r @ cr
+    return r, t
 
 
 @njit(cache=True, fastmath=False)

@@ -373,7 +373,7 @@ def build_articulator(cfg: Config, mesh: Mesh, wall: WallSurface | None = None, 
         nodes = np.unique(sets["surface"])  # the dorsal surface and the tip (the underside rests on the floor)
         jaw_frame = np.array([body.names[k] for k in ("symphysis_l", "symphysis_r", "coronoid_l", "gonion_r",
                                                       "condyle_l")])
-        cm = contact_model(wall, nodes, jaw_frame, body.nodes[jaw_frame],
+        cm = contact_model(wall, nodes, mesh.nodes[nodes], jaw_frame, body.nodes[jaw_frame],
                            units.newton_to_dyn(cfg.contact.stiffness_n_per_cm), cfg.contact.tolerance_cm)
     g = cfg.simulation.gravity_cm_s2 if gravity is None else gravity
     tone = np.zeros(len(names))
