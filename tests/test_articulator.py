@@ -165,3 +165,24 @@ def test_known_direction_differences(directions, muscle, cp, request):
 def test_every_definite_direction_is_tested():
     listed = {(m, c) for m, d in PAPER_DIRECTIONS.items() for c in d}
     assert listed == set(AGREE) | set(KNOWN)
+
+
+def test_a_run_leaves_no_reference_cycles(art):
+    """run() pauses the cyclic garbage collector while stepping; that is only harmless if steps make no
+    reference cycles, so nothing may be left for the collector after a run with contact and muscles."""
+    import gc
+
+    rest = settle(art)
+    ctl = Control(force=np.zeros((art.n_nodes, 3)), activation=activation_vector(art, {"SG": 4.0, "JO": 3.0}))
+    run(art, rest, lambda t: ctl, 0.02)
+    gc.collect()
+    was = gc.isenabled()
+    gc.disable()
+    try:
+        run(art, rest, lambda t: ctl, 0.05)
+        left = gc.collect()
+    finally:
+        if was:
+            gc.enable()
+    assert left == 0
+    assert gc.isenabled() == was  # run() gave the collector back as it found it

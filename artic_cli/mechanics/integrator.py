@@ -197,11 +197,16 @@ def rank_one_terms(model: Model, x: np.ndarray, fs: FibreState | None, act: np.n
     return np.hstack(cols), np.concatenate(ks)
 
 
+def _same_step(state: State, h: float) -> bool:
+    """Whether the state's history was taken with steps of ``h`` (then the multistep formulas use it)."""
+    return len(state.history) >= 2 and state.history_dt is not None and abs(state.history_dt - h) <= 1e-9 * h
+
+
 def _coefficients(model: Model, state: State, h: float):
     x0, v0 = state.x, state.v
     if model.options.scheme == "bdf1":
         return 1.0 / h**2, -x0 / h**2 - v0 / h, 1.0 / h, -x0 / h, (x0,)
-    if len(state.history) >= 2 and np.isclose(state.history_dt, h):
+    if _same_step(state, h):
         x1, x2 = state.history[:2]
     else:  # start (or change of step): history consistent with the current velocity
         x1, x2 = x0 - h * v0, x0 - 2.0 * h * v0
@@ -212,7 +217,7 @@ def _coefficients(model: Model, state: State, h: float):
 
 def _predict(state: State, h: float) -> np.ndarray:
     """Starting guess: quadratic extrapolation of the last three positions."""
-    if len(state.history) >= 2 and np.isclose(state.history_dt, h):
+    if _same_step(state, h):
         x1, x2 = state.history[:2]
         return 3.0 * state.x - 3.0 * x1 + x2
     return state.x + h * state.v
