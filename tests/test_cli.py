@@ -215,3 +215,24 @@ def test_export_writes_paraview_files_and_ema_csv(mesh_file, tmp_path):
     assert len(rows) == 6
     bad = artic("export", "--mesh", mesh_file, "--csv", tmp_path / "x.csv")
     assert_one_line_error(bad, "--sim")
+
+
+def test_a_ctrl_c_inside_compiled_code_counts_as_an_interrupt():
+    """numba turns a KeyboardInterrupt that lands during a callback into SystemError (cause: the interrupt);
+    the CLI must still exit with 130 and its one line, and must not swallow genuine SystemErrors."""
+    from artic_cli.cli.main import interrupted
+
+    def raised(inner):
+        try:
+            try:
+                raise inner
+            except BaseException as err:
+                raise SystemError("returned a result with an exception set") from err
+        except SystemError as outer:
+            return outer
+
+    assert interrupted(KeyboardInterrupt())
+    assert interrupted(raised(KeyboardInterrupt()))
+    assert not interrupted(SystemError("compiled code failed"))
+    assert interrupted(raised(raised(KeyboardInterrupt())))
+    assert not interrupted(raised(ValueError("a real bug")))

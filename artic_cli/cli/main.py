@@ -28,6 +28,18 @@ out_console = Console(width=None if sys.stdout.isatty() else 120)
 err_console = Console(stderr=True)
 
 
+def interrupted(err: BaseException) -> bool:
+    """Whether ``err`` is a Ctrl-C: a KeyboardInterrupt, or the SystemError numba raises when the interrupt
+    lands while compiled code is calling back into Python (the KeyboardInterrupt is then its cause)."""
+    seen = set()
+    while err is not None and id(err) not in seen:
+        if isinstance(err, KeyboardInterrupt):
+            return True
+        seen.add(id(err))
+        err = err.__cause__ or err.__context__
+    return False
+
+
 def handle_errors(fn):
     """Turn ArticError into one line on stderr and its exit status."""
 
@@ -38,7 +50,9 @@ def handle_errors(fn):
         except ArticError as err:
             err_console.print(f"[bold red]error:[/] {err}", highlight=False, soft_wrap=True)
             raise typer.Exit(err.exit_code) from None
-        except KeyboardInterrupt:
+        except (KeyboardInterrupt, SystemError) as err:
+            if not interrupted(err):
+                raise
             err_console.print("interrupted; no partial output was kept")
             raise typer.Exit(130) from None
 
@@ -240,7 +254,9 @@ def ep_map_cmd(
     try:
         r = _with_progress("equilibria", lambda update: build_ep_maps(mesh, config, out, jobs, backend, scheduler, fast,
                                                                       cache, update, force), plain=True)
-    except KeyboardInterrupt:
+    except (KeyboardInterrupt, SystemError) as err:
+        if not interrupted(err):
+            raise
         err_console.print(f"interrupted; {out} was not touched, finished equilibria are cached and a rerun "
                           "resumes from them")
         raise typer.Exit(130) from None
@@ -286,7 +302,9 @@ def muscle_function_cmd(
     try:
         mf, wall, cached, distinct = _with_progress(
             "starts", lambda update: build_muscle_function(mesh, config, out, jobs, cache, update), plain=True)
-    except KeyboardInterrupt:
+    except (KeyboardInterrupt, SystemError) as err:
+        if not interrupted(err):
+            raise
         err_console.print(f"interrupted; {out} was not touched, finished starts are cached and a rerun resumes")
         raise typer.Exit(130) from None
     out_console.print(f"wrote {out}: {len(mf.starts)} starts ({distinct} distinct force sets, {cached} from the "
