@@ -1,4 +1,4 @@
-"""The whole articulator: muscles, jaw and hyoid, contact (work in progress on issue 3)."""
+"""The whole articulator: muscles, jaw and hyoid, contact, against the paper's section III experiments."""
 
 import numpy as np
 import pytest
