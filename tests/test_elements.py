@@ -211,6 +211,27 @@ def test_wall_query_finds_the_closest_wall_point_exactly(art):
     assert outside >= 40 * 3  # the brute-force fallback was exercised too
 
 
+def test_compiled_candidate_grid_lists_the_numpy_candidates(art):
+    """The compiled grid builder (bounding spheres) and the numpy one (KD-tree balls) list the same triangles
+    for every voxel."""
+    from artic_cli.mechanics import contact, elements, kernels
+
+    if not kernels.AVAILABLE:
+        pytest.skip("numba not installed: only the numpy path runs")
+    cm = art.contact
+    lo, hi = cm.fixed_grid.lo, cm.fixed_grid.lo + cm.fixed_grid.spacing * cm.fixed_grid.dims
+    grids = {}
+    for flag in (False, True):
+        elements.USE_KERNELS = flag
+        try:
+            grids[flag] = contact.candidate_grid(cm.corners, cm.jaw_grid.tris, lo, hi)
+        finally:
+            elements.USE_KERNELS = True
+    assert np.array_equal(grids[False].offsets, grids[True].offsets)
+    assert np.array_equal(grids[False].cands, grids[True].cands)
+    assert 3 < len(grids[True].cands) / (len(grids[True].offsets) - 1) < 60  # a real short list per voxel
+
+
 def test_carried_points_move_rigidly_with_the_mandible(art):
     """Incisor, muscle origins and the tongue's GG origin line keep their distances to the mandible's nodes
     through a jaw-opening simulation, and the incisor stays in the midsagittal plane."""

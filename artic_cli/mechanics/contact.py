@@ -65,9 +65,13 @@ def candidate_grid(corners: np.ndarray, tris: np.ndarray, lo: np.ndarray, hi: np
     dims = np.maximum(np.ceil((np.asarray(hi) - lo) / spacing), 1).astype(np.int64)
     axes = [lo[a] + spacing * (np.arange(dims[a]) + 0.5) for a in range(3)]
     centres = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+    slack = spacing * np.sqrt(3.0)  # the voxel's diameter, 2 r
+    tris = np.asarray(tris, dtype=np.int64)
+    if kernels.AVAILABLE and elements.USE_KERNELS:
+        offsets, cands = kernels.grid_candidates(centres, tris, np.ascontiguousarray(corners), slack + 1e-9)
+        return CandidateGrid(lo=lo, spacing=float(spacing), dims=dims, offsets=offsets, cands=cands, tris=tris)
     tri_centre = corners[tris].mean(axis=1)
     reach = float(np.linalg.norm(corners[tris] - tri_centre[:, None], axis=2).max())  # centre to farthest corner
-    slack = spacing * np.sqrt(3.0)  # the voxel's diameter, 2 r
     tree = cKDTree(tri_centre)
     _, near = tree.query(centres, k=min(4, len(tris)))
     near = near.reshape(len(centres), -1)
@@ -84,14 +88,11 @@ def candidate_grid(corners: np.ndarray, tris: np.ndarray, lo: np.ndarray, hi: np
     point, tri = point[keep], tri[keep]
     order = np.lexsort((tri, point))
     offsets = np.r_[0, np.cumsum(np.bincount(point, minlength=len(centres)))]
-    return CandidateGrid(lo=lo, spacing=float(spacing), dims=dims, offsets=offsets, cands=tri[order],
-                         tris=np.asarray(tris, dtype=np.int64))
+    return CandidateGrid(lo=lo, spacing=float(spacing), dims=dims, offsets=offsets, cands=tri[order], tris=tris)
 
 
 def _distances(p: np.ndarray, tri: np.ndarray, corners: np.ndarray) -> np.ndarray:
     """Distance from each point p (K,3) to its triangle tri (K,)."""
-    if kernels.AVAILABLE:
-        return kernels.triangle_distances(np.ascontiguousarray(p), tri, np.ascontiguousarray(corners))
     c = corners[tri]
     q = closest_on_triangles(p, c[:, 0], c[:, 1], c[:, 2])
     return np.linalg.norm(p - q, axis=1)
@@ -124,7 +125,9 @@ def contact_model(wall: WallSurface, nodes: np.ndarray, points: np.ndarray, jaw_
     corners = wall.vertices[wall.triangles]
     jaw = np.flatnonzero(wall.part == PARTS.index("mandible"))
     fixed = np.flatnonzero(wall.part != PARTS.index("mandible"))
-    lo, hi = points.min(axis=0) - GRID_REACH, points.max(axis=0) + GRID_REACH
+    # the grids cover where the contact nodes can be: around their rest positions, inside the wall's box
+    lo = np.maximum(points.min(axis=0) - GRID_REACH, wall.vertices.min(axis=0))
+    hi = np.minimum(points.max(axis=0) + GRID_REACH, wall.vertices.max(axis=0))
     return ContactModel(nodes=np.asarray(nodes), wall=wall, fixed_grid=candidate_grid(corners, fixed, lo, hi),
                         jaw_grid=candidate_grid(corners, jaw, lo, hi), jaw_nodes=jaw_nodes,
                         jaw_rest=jaw_rest, stiffness=stiffness, tolerance=tolerance)

@@ -274,13 +274,61 @@ def _closest_on_triangle(p, t):
 
 
 @njit(cache=True, fastmath=False)
-def triangle_distances(p, tri, corners):
-    """Distance from each point p (K,3) to its triangle tri (K,) (corners (T,3,3))."""
-    d = np.empty(len(tri))
-    for k in range(len(tri)):
-        q0, q1, q2 = _closest_on_triangle(p[k], corners[tri[k]])
-        d[k] = np.sqrt((p[k, 0] - q0) ** 2 + (p[k, 1] - q1) ** 2 + (p[k, 2] - q2) ** 2)
-    return d
+def grid_candidates(centres, tris, corners, slack):
+    """For each voxel centre (V,3): the triangles of ``tris`` within ``slack`` of its smallest distance to
+    them (see :class:`..contact.CandidateGrid`).  Returns offsets (V+1,) and triangle indices.
+
+    Bounding spheres skip most exact distances: d(c, T) >= |c - centre_T| - reach_T."""
+    nt = len(tris)
+    mid = np.empty((nt, 3))
+    reach = np.empty(nt)
+    for k in range(nt):
+        for a in range(3):
+            mid[k, a] = (corners[tris[k], 0, a] + corners[tris[k], 1, a] + corners[tris[k], 2, a]) / 3.0
+        r = 0.0
+        for v in range(3):
+            d = 0.0
+            for a in range(3):
+                d += (corners[tris[k], v, a] - mid[k, a]) ** 2
+            r = max(r, np.sqrt(d))
+        reach[k] = r
+    nv = centres.shape[0]
+    offsets = np.zeros(nv + 1, dtype=np.int64)
+    out = np.empty(nv * 8, dtype=np.int64)
+    lower = np.empty(nt)
+    exact = np.empty(nt)
+    used = 0
+    for v in range(nv):
+        c = centres[v]
+        nearest, best = 0, np.inf
+        for k in range(nt):
+            d = np.sqrt((c[0] - mid[k, 0]) ** 2 + (c[1] - mid[k, 1]) ** 2 + (c[2] - mid[k, 2]) ** 2)
+            lower[k] = d - reach[k]
+            if d < best:
+                nearest, best = k, d
+        q0, q1, q2 = _closest_on_triangle(c, corners[tris[nearest]])
+        upper = np.sqrt((c[0] - q0) ** 2 + (c[1] - q1) ** 2 + (c[2] - q2) ** 2)  # >= the smallest distance
+        dmin = np.inf
+        for k in range(nt):
+            exact[k] = np.inf
+            if lower[k] <= upper:
+                q0, q1, q2 = _closest_on_triangle(c, corners[tris[k]])
+                exact[k] = np.sqrt((c[0] - q0) ** 2 + (c[1] - q1) ** 2 + (c[2] - q2) ** 2)
+                dmin = min(dmin, exact[k])
+        for k in range(nt):
+            if lower[k] <= dmin + slack:
+                if exact[k] == np.inf:
+                    q0, q1, q2 = _closest_on_triangle(c, corners[tris[k]])
+                    exact[k] = np.sqrt((c[0] - q0) ** 2 + (c[1] - q1) ** 2 + (c[2] - q2) ** 2)
+                if exact[k] <= dmin + slack:
+                    if used == len(out):
+                        grown = np.empty(2 * len(out), dtype=np.int64)
+                        grown[:used] = out[:used]
+                        out = grown
+                    out[used] = tris[k]
+                    used += 1
+        offsets[v + 1] = used
+    return offsets, out[:used].copy()
 
 
 @njit(cache=True, fastmath=False)
