@@ -132,15 +132,15 @@ def tangent(model: Model, cs: elements.CylinderState, frame: elements.DampingFra
         kf = fibre_stiffness(ms, fs, act, h)
         soft = np.where(kf < _RANK_ONE_STIFFNESS, kf * ms.fibre_l0, 0.0)  # split in series
         k_seg = t[:, None, None] * (_EYE - nn) + (soft[ms.seg_fibre] / ms.seg_l0)[:, None, None] * nn
-        seg = (ms.seg_i, ms.seg_j)
-    else:
+        seg, seg_pair = (ms.seg_i, ms.seg_j), asm.seg_pair
+    else:  # no fibres (or none evaluated): no segment blocks
         k_seg = np.zeros((0, 3, 3))
-        seg = (np.zeros(0, dtype=np.int64),) * 2
+        seg_pair = np.zeros(0, dtype=np.int64)
+        seg = (seg_pair, seg_pair)
     if kernels.AVAILABLE and elements.USE_KERNELS:
         blocks = kernels.node_blocks(cs.n, cs.length, cs.elastic, axial, frame.n, frame.c, c_v, signed_geometry,
                                      cyl.i, cyl.j, asm.cyl_pair, model.bricks, asm.brick_pair, grad, w,
-                                     seg[0], seg[1], asm.seg_pair if fs is not None else seg[0], k_seg,
-                                     asm.n_pairs, model.n_nodes)
+                                     seg[0], seg[1], seg_pair, k_seg, asm.n_pairs, model.n_nodes)
     else:
         k_geo = (cs.elastic if signed_geometry else np.maximum(cs.elastic, 0.0)) / cs.length
         k_nn = np.maximum(axial, 0.0) - k_geo
@@ -199,7 +199,7 @@ def rank_one_terms(model: Model, x: np.ndarray, fs: FibreState | None, act: np.n
 
 def _same_step(state: State, h: float) -> bool:
     """Whether the state's history was taken with steps of ``h`` (then the multistep formulas use it)."""
-    return len(state.history) >= 2 and state.history_dt is not None and abs(state.history_dt - h) <= 1e-9 * h
+    return len(state.history) >= 2 and abs(state.history_dt - h) <= 1e-9 * h
 
 
 def _coefficients(model: Model, state: State, h: float):
