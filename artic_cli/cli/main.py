@@ -6,6 +6,7 @@ one line on stderr and exit status 2 (3 for an unreachable target).
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import json
 import sys
@@ -40,21 +41,29 @@ def interrupted(err: BaseException) -> bool:
     return False
 
 
+@contextlib.contextmanager
+def exit_on_interrupt(message: str):
+    """Turn a Ctrl-C (see :func:`interrupted`) into ``message`` on stderr and exit status 130."""
+    try:
+        yield
+    except (KeyboardInterrupt, SystemError) as err:
+        if not interrupted(err):
+            raise
+        err_console.print(message)
+        raise typer.Exit(130) from None
+
+
 def handle_errors(fn):
-    """Turn ArticError into one line on stderr and its exit status."""
+    """Turn ArticError into one line on stderr and its exit status; a Ctrl-C into one line and 130."""
 
     @functools.wraps(fn)
     def wrapper(*args, **kwargs):
         try:
-            return fn(*args, **kwargs)
+            with exit_on_interrupt("interrupted; no partial output was kept"):
+                return fn(*args, **kwargs)
         except ArticError as err:
             err_console.print(f"[bold red]error:[/] {err}", highlight=False, soft_wrap=True)
             raise typer.Exit(err.exit_code) from None
-        except (KeyboardInterrupt, SystemError) as err:
-            if not interrupted(err):
-                raise
-            err_console.print("interrupted; no partial output was kept")
-            raise typer.Exit(130) from None
 
     return wrapper
 
@@ -251,15 +260,10 @@ def ep_map_cmd(
     from ..control.epmap import build_ep_maps
     from ..experiments.paper import PAPER_CONTRIBUTION
 
-    try:
+    with exit_on_interrupt(f"interrupted; {out} was not touched, finished equilibria are cached and a rerun "
+                           "resumes from them"):
         r = _with_progress("equilibria", lambda update: build_ep_maps(mesh, config, out, jobs, backend, scheduler, fast,
                                                                       cache, update, force), plain=True)
-    except (KeyboardInterrupt, SystemError) as err:
-        if not interrupted(err):
-            raise
-        err_console.print(f"interrupted; {out} was not touched, finished equilibria are cached and a rerun "
-                          "resumes from them")
-        raise typer.Exit(130) from None
     if r.up_to_date:
         out_console.print(f"{r.path} is up to date (same mesh, config and map spec); nothing to do "
                           "(--force rewrites it)", highlight=False)
@@ -299,14 +303,9 @@ def muscle_function_cmd(
     """Section IV.A.1: each muscle at 4 N for 150 ms from scattered starts (Figs. 5 and 6)."""
     from ..experiments.muscle_function import build_muscle_function, convergence
 
-    try:
+    with exit_on_interrupt(f"interrupted; {out} was not touched, finished starts are cached and a rerun resumes"):
         mf, wall, cached, distinct = _with_progress(
             "starts", lambda update: build_muscle_function(mesh, config, out, jobs, cache, update), plain=True)
-    except (KeyboardInterrupt, SystemError) as err:
-        if not interrupted(err):
-            raise
-        err_console.print(f"interrupted; {out} was not touched, finished starts are cached and a rerun resumes")
-        raise typer.Exit(130) from None
     out_console.print(f"wrote {out}: {len(mf.starts)} starts ({distinct} distinct force sets, {cached} from the "
                       f"cache) x {len(mf.muscles)} muscles in {wall:.1f} s", highlight=False)
     table = Table(title=f"Where each muscle drives the control points ({mf.drive_n:g} N, {mf.drive_ms:g} ms)")
