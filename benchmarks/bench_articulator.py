@@ -21,7 +21,7 @@ from artic_cli.config import load_config  # noqa: E402
 from artic_cli.geometry.mesh import tongue_mesh  # noqa: E402
 from artic_cli.geometry.wall import wall_surface  # noqa: E402
 from artic_cli.mechanics import integrator  # noqa: E402
-from artic_cli.mechanics.loads import activation_vector  # noqa: E402
+from artic_cli.mechanics.loads import muscle_force_vector  # noqa: E402
 from artic_cli.mechanics.model import Control, build_articulator  # noqa: E402
 from artic_cli.mechanics.simulate import run, settle  # noqa: E402
 
@@ -34,7 +34,7 @@ def main() -> None:
     cfg = load_config(ROOT / "configs" / "default.yaml")
     model = build_articulator(cfg, tongue_mesh(cfg.speaker.tongue), wall_surface(cfg.speaker.wall))
     rest = settle(model)
-    ctl = Control(force=np.zeros((model.n_nodes, 3)), activation=activation_vector(model, {"SG": 4.0, "JO": 3.0}))
+    ctl = Control(node_force=np.zeros((model.n_nodes, 3)), muscle_force=muscle_force_vector(model, {"SG": 4.0, "JO": 3.0}))
     spent = {"contact": 0.0}
     for name in ("contact_planes", "contact_forces", "enforce"):
         fn = getattr(integrator, name)
@@ -57,7 +57,7 @@ def main() -> None:
     wall = float(np.median(walls))
     ratio = wall / 0.3
     print(f"articulator: {model.n_nodes} nodes ({model.n_tongue} tongue), {len(model.muscle_names)} muscles, "
-          f"{len(model.cyl.i)} cylinders and links, dt = {model.options.dt * 1e3:g} ms")
+          f"{len(model.springs.i)} cylinders and links, dt = {model.options.dt * 1e3:g} ms")
     print(f"300 ms of SG 4 N + JO 3 N, {REPEATS} runs: {', '.join(f'{w * 1e3:.0f}' for w in walls)} ms wall; "
           f"median {ratio:.2f} s per simulated second (slowest {max(walls) / 0.3:.2f}; goal <= {GOAL}) -> "
           f"{'MET' if ratio <= GOAL else 'NOT MET'}")

@@ -55,7 +55,7 @@ def main() -> None:
     f = np.zeros((model.n_nodes, 3))
     blade = model.node_set("blade")
     f[blade] = np.array([1.4, 1.4, 0.0]) * 1e5 / len(blade)  # 2 N pull
-    ctl = Control(force=f)
+    ctl = Control(node_force=f)
     duration = 0.3
     run(model, rest_state(model), lambda t: ctl, duration)  # warm-up
     walls, diag = [], []
@@ -76,7 +76,7 @@ def main() -> None:
     assembly.BandFactor.solve = orig_solve
 
     ratio = med / duration
-    print(f"tissue model: 231 nodes, {len(model.cyl.i)} cylinders, band half-width {model.pattern.u}, "
+    print(f"tissue model: 231 nodes, {len(model.springs.i)} cylinders, band half-width {model.pattern.u}, "
           f"dt = {model.options.dt * 1e3:g} ms, {traj.stats['steps']} steps")
     print(f"300 ms simulation: median {med * 1e3:.1f} ms, best {best * 1e3:.1f} ms wall (7 runs); "
           f"afterwards volumes, energies and inversion checks of all frames: {statistics.median(diag) * 1e3:.1f} ms")

@@ -6,7 +6,7 @@ import pytest
 from artic_cli.errors import ArticError
 from artic_cli.experiments.paper import PAPER_DIRECTIONS, fig4, jaw_ep, muscle_directions, stress
 from artic_cli.mechanics.contact import wall_query
-from artic_cli.mechanics.loads import activation_vector
+from artic_cli.mechanics.loads import muscle_force_vector
 from artic_cli.mechanics.model import Control, build_articulator
 from artic_cli.mechanics.muscles import FL_RANGE, force_length
 from artic_cli.mechanics.simulate import run, settle
@@ -59,7 +59,7 @@ def test_without_tone_gravity_drops_the_jaw(cfg, mesh, wall):
 
 
 def test_a_strong_muscle_keeps_volume_and_stays_inside_the_wall(art, rest):
-    ctl = Control(force=np.zeros((art.n_nodes, 3)), activation=activation_vector(art, {"SG": 4.0, "GGp": 2.0}))
+    ctl = Control(node_force=np.zeros((art.n_nodes, 3)), muscle_force=muscle_force_vector(art, {"SG": 4.0, "GGp": 2.0}))
     traj, end = run(art, rest, lambda t: ctl, 0.2)
     assert np.isfinite(traj.x).all() and traj.inverted.max() == 0
     assert np.abs(traj.volume_change).max() <= 0.003
@@ -173,7 +173,7 @@ def test_a_run_leaves_no_reference_cycles(art):
     import gc
 
     rest = settle(art)
-    ctl = Control(force=np.zeros((art.n_nodes, 3)), activation=activation_vector(art, {"SG": 4.0, "JO": 3.0}))
+    ctl = Control(node_force=np.zeros((art.n_nodes, 3)), muscle_force=muscle_force_vector(art, {"SG": 4.0, "JO": 3.0}))
     run(art, rest, lambda t: ctl, 0.02)
     gc.collect()
     was = gc.isenabled()

@@ -12,12 +12,12 @@ STRESS_7N = {"blade": (7.0, 0.0, 0.0), "dorsum_region": (0.0, 7.0, 0.0), "root":
 
 
 def _run(model, forces, duration, dt=None):
-    ctl = Control(force=set_force(model, forces))
+    ctl = Control(node_force=set_force(model, forces))
     return run(model, rest_state(model), lambda t: ctl, duration, dt)[0]
 
 
 def test_gravity_equilibrium_converges_and_does_not_depend_on_dt(model):
-    ctl = Control(force=np.zeros((model.n_nodes, 3)))
+    ctl = Control(node_force=np.zeros((model.n_nodes, 3)))
     ends = []
     for dt in (0.005, 0.0025):
         state, ok = equilibrate(model, rest_state(model), ctl, dt=dt, tol=1e-3, max_time=3.0)
@@ -70,7 +70,7 @@ def test_volume_constraint_holds_volume_and_its_absence_shows_the_drift(cfg, mes
 @pytest.mark.parametrize("scheme", ["houbolt", "bdf1"])
 def test_both_schemes_reach_the_same_equilibrium(model, scheme):
     m = with_options(model, scheme=scheme)
-    ctl = Control(force=set_force(m, PULL_2N))
+    ctl = Control(node_force=set_force(m, PULL_2N))
     s, ok = equilibrate(m, rest_state(m), ctl, dt=0.01, tol=1e-3, max_time=5.0)
     assert ok
     ref, _ = equilibrate(model, rest_state(model), ctl, dt=0.01, tol=1e-3, max_time=5.0)

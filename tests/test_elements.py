@@ -12,7 +12,7 @@ from artic_cli.mechanics.simulate import mechanical_energy
 
 
 def test_youngs_modulus_is_constant_below_20_percent_and_rises_beyond(model):
-    cyl = model.cyl
+    cyl = model.springs
     strain = np.linspace(-0.3, 0.5, len(cyl.i))
     e, de = elements.youngs_modulus(cyl, strain)
     low = strain <= 0.2
@@ -25,11 +25,11 @@ def test_radius_law_sets_the_cross_section(model):
     # a cylinder stretched by 10 %: area shrinks by (1 - nu * 0.1)^2 (Eq. 4)
     x = model.mesh.nodes.copy()
     c = 0
-    i, j = model.cyl.i[c], model.cyl.j[c]
+    i, j = model.springs.i[c], model.springs.j[c]
     x[j] = x[i] + 1.1 * (x[j] - x[i])
-    cs = elements.evaluate(model.cyl, x)
-    nu = model.cyl.poisson[c]
-    expect = model.cyl.youngs[c] * 0.1 * model.cyl.area0[c] * (1 - nu * 0.1) ** 2
+    cs = elements.evaluate(model.springs, x)
+    nu = model.springs.poisson[c]
+    expect = model.springs.youngs[c] * 0.1 * model.springs.area0[c] * (1 - nu * 0.1) ** 2
     assert cs.elastic[c] == pytest.approx(expect, rel=1e-9)
 
 
@@ -95,7 +95,7 @@ def test_compiled_kernels_give_the_numpy_numbers(art):
     b = art.bricks[7]
     x[b[6]] = x[b[0]] + 0.2 * (x[b[6]] - x[b[0]])  # squash one brick so that the guard acts
     v = rng.normal(0, 1.0, x.shape)
-    frame = elements.damping_frame(art.cyl, art.rest)
+    frame = elements.damping_frame(art.springs, art.rest)
     act = np.full(len(art.muscle_names), 2.0e5)
     ms = art.muscles
     out = {}
@@ -129,12 +129,12 @@ def test_node_level_assembly_is_t_transpose_k_t_of_the_element_blocks(art):
         a = rng.normal(size=(k, 3, 3))
         return a + a.transpose(0, 2, 1)
 
-    k_cyl, k_seg = sym(len(art.cyl.i)), sym(len(ms.seg_i))
+    k_cyl, k_seg = sym(len(art.springs.i)), sym(len(ms.seg_i))
     grad, w = rng.normal(size=(len(art.bricks), 8, 3)), rng.uniform(0.5, 2.0, len(art.bricks))
-    blocks = asm.blocks(n, (art.cyl.i, art.cyl.j), k_cyl, art.bricks, grad, w, (ms.seg_i, ms.seg_j), k_seg)
+    blocks = asm.blocks(n, (art.springs.i, art.springs.j), k_cyl, art.bricks, grad, w, (ms.seg_i, ms.seg_j), k_seg)
     mat = pat.unpack(asm.operator @ blocks.ravel())
     g = grad.reshape(len(w), 24)
-    dense = (sparse_blocks(np.column_stack([art.cyl.i, art.cyl.j]), pair_blocks(k_cyl), n)
+    dense = (sparse_blocks(np.column_stack([art.springs.i, art.springs.j]), pair_blocks(k_cyl), n)
              + sparse_blocks(art.bricks, w[:, None, None] * g[:, :, None] * g[:, None, :], n)
              + sparse_blocks(np.column_stack([ms.seg_i, ms.seg_j]), pair_blocks(k_seg), n))
     t = pat.reduce.toarray()
@@ -235,12 +235,12 @@ def test_compiled_candidate_grid_lists_the_numpy_candidates(art):
 def test_carried_points_move_rigidly_with_the_mandible(art):
     """Incisor, muscle origins and the tongue's GG origin line keep their distances to the mandible's nodes
     through a jaw-opening simulation, and the incisor stays in the midsagittal plane."""
-    from artic_cli.mechanics.loads import activation_vector
+    from artic_cli.mechanics.loads import muscle_force_vector
     from artic_cli.mechanics.model import Control
     from artic_cli.mechanics.simulate import run, settle
 
     rest = settle(art)
-    ctl = Control(force=np.zeros((art.n_nodes, 3)), activation=activation_vector(art, {"JO": 3.0, "SG": 4.0}))
+    ctl = Control(node_force=np.zeros((art.n_nodes, 3)), muscle_force=muscle_force_vector(art, {"JO": 3.0, "SG": 4.0}))
     traj, end = run(art, rest, lambda t: ctl, 0.1)
     car = art.carried
     jaw = art.node_set("mandible")

@@ -36,7 +36,7 @@ from ..config import Config, EPMapSpec, config_hash, load_config, model_hash, pa
 from ..errors import ArticError
 from ..geometry.anatomy import JAW_MUSCLES, TONGUE_MUSCLES
 from ..io.store import atomic_h5, file_hash, load_mesh, open_artifact
-from ..mechanics.loads import activation_vector
+from ..mechanics.loads import muscle_force_vector
 from ..mechanics.model import Control, Model, State, build_articulator
 from ..mechanics.simulate import equilibrate, hold, settle
 
@@ -142,7 +142,7 @@ def add_forces(*parts: dict[str, float]) -> dict[str, float]:
 # --- one equilibrium (physics; usable without maps) ------------------------------------------------
 
 def control_for(model: Model, forces_n: dict[str, float]) -> Control:
-    return Control(force=np.zeros((model.n_nodes, 3)), activation=activation_vector(model, forces_n))
+    return Control(node_force=np.zeros((model.n_nodes, 3)), muscle_force=muscle_force_vector(model, forces_n))
 
 
 def watch_nodes(model: Model) -> np.ndarray:

@@ -71,7 +71,7 @@ def run_cuboid(cfg: Config, forces_n=None, volume_constraint: bool | None = None
         for level in np.linspace(done, fn, int(np.ceil((fn - done) / 0.5)) + 1)[1:]:
             f = np.zeros_like(x0)
             f[face, 0] = units.newton_to_dyn(level) * weights
-            state, ok = equilibrate(model, state, Control(force=f), dt=0.02, tol=1e-3, max_time=10.0)
+            state, ok = equilibrate(model, state, Control(node_force=f), dt=0.02, tol=1e-3, max_time=10.0)
         done = fn
         x = state.x
         axial = x[face, 0].mean() / size[0] - 1.0

@@ -12,7 +12,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from ..mechanics.contact import wall_query
-from ..mechanics.loads import activation_vector
+from ..mechanics.loads import muscle_force_vector
 from ..mechanics.model import Control, Model
 from ..mechanics.simulate import run, settle
 
@@ -55,7 +55,7 @@ class Row:
 
 
 def _control(model: Model, forces_n: dict[str, float]) -> Control:
-    return Control(force=np.zeros((model.n_nodes, 3)), activation=activation_vector(model, forces_n))
+    return Control(node_force=np.zeros((model.n_nodes, 3)), muscle_force=muscle_force_vector(model, forces_n))
 
 
 class Audit:

@@ -45,8 +45,8 @@ class SimulationDiverged(ArticError):
 def internal_forces(model: Model, x: np.ndarray, v: np.ndarray | None = None,
                     frame: elements.DampingFrame | None = None):
     """Forces on the nodes from cylinders, links and the volume constraint (dyn)."""
-    cs = elements.evaluate(model.cyl, x)
-    f = elements.nodal_forces(model.cyl, cs, frame, v, model.scatter)
+    cs = elements.evaluate(model.springs, x)
+    f = elements.nodal_forces(model.springs, cs, frame, v, model.scatter)
     grad = vol = None
     nt = model.n_tongue
     if kernels.AVAILABLE and elements.USE_KERNELS and model.corner_j0 is not None:
@@ -83,11 +83,11 @@ def guide_forces(model: Model, x: np.ndarray) -> np.ndarray:
     return f
 
 
-def total_activation(model: Model, activation: np.ndarray | None) -> np.ndarray | None:
+def total_muscle_force(model: Model, muscle_force: np.ndarray | None) -> np.ndarray | None:
     """The control's muscle forces plus the model's postural tone (dyn), or None without muscles."""
     if model.muscles is None:
         return None
-    act = np.zeros(len(model.muscles.names)) if activation is None else activation
+    act = np.zeros(len(model.muscles.names)) if muscle_force is None else muscle_force
     return act + model.tone if model.tone is not None else act
 
 
@@ -120,7 +120,7 @@ def tangent(model: Model, cs: elements.CylinderState, frame: elements.DampingFra
     """The banded part of the Newton matrix: mass, cylinders and links, volume, fibres' own blocks, guide."""
     # geometric stiffness T / l with its sign: compressed cylinders soften sideways (the mass term keeps
     # the matrix positive definite at these loads; a failed factorisation falls back to clipping)
-    cyl, asm = model.cyl, model.assembly
+    cyl, asm = model.springs, model.assembly
     axial = elements.axial_stiffness(cyl, cs)
     nb = len(model.brick_v0)
     grad = np.zeros((0, 8, 3)) if grad is None else grad.reshape(nb, 8, 3)
@@ -254,20 +254,20 @@ def _step_split(model: Model, state: State, control: Control, h: float, depth: i
 def _step_once(model: Model, state: State, control: Control, h: float) -> State:
     opt = model.options
     c_a, a_known, c_v, v_known, history = _coefficients(model, state, h)
-    f_ext = control.force + model.node_mass[:, None] * model.gravity
+    f_ext = control.node_force + model.node_mass[:, None] * model.gravity
     reduce, reduce_t = model.pattern.reduce, model.pattern.reduce_t
     x = _predict(state, h)
     x[model.fixed] = state.x[model.fixed]
     if model.carried is not None:
         model.carried.place(x)
     refactors = state.refactors
-    frame = elements.damping_frame(model.cyl, state.x)
+    frame = elements.damping_frame(model.springs, state.x)
     planes = None
     if model.contact is not None:
         cached = state.wall_cache is not None and state.wall_cache[0] is state.x
         planes = contact_planes(model.contact, state.x, state.wall_cache[1] if cached else None)
     ms = model.muscles
-    act = total_activation(model, control.activation)
+    act = total_muscle_force(model, control.muscle_force)
     key = (c_a, c_v)
     base = state.factor.base if state.factor is not None and state.factor.key == key else None
     factor = state.factor if base is not None else None  # rank-one part too, while the contact set holds

@@ -15,7 +15,7 @@ from .model import Control, Model
 @dataclass(frozen=True)
 class LoadProgram:
     """Piecewise-constant inputs: load k acts on ``nodes[k]`` in [on, off); muscle entry m adds
-    ``muscle_force[m] * muscle_share[m]`` to the activations in [m_on, m_off)."""
+    ``muscle_force[m] * muscle_share[m]`` to the muscle forces in [m_on, m_off)."""
 
     nodes: tuple[np.ndarray, ...]
     force: np.ndarray  # (K,3) per-node force, dyn
@@ -34,11 +34,11 @@ class LoadProgram:
             np.add.at(f, self.nodes[k], self.force[k])
         live = (self.m_on <= t + eps) & (t + eps < self.m_off)
         act = (self.muscle_force * live) @ self.muscle_share if len(self.muscle_force) else self.muscle_share.sum(0)
-        return Control(force=f, activation=act)
+        return Control(node_force=f, muscle_force=act)
 
 
-def activation_vector(model: Model, forces_n: dict[str, float]) -> np.ndarray:
-    """Muscle activations (dyn) from {muscle or group: force in N}."""
+def muscle_force_vector(model: Model, forces_n: dict[str, float]) -> np.ndarray:
+    """Each muscle unit's force (dyn) from {muscle or group: force in N}."""
     act = np.zeros(len(model.muscle_names))
     for name, fn in forces_n.items():
         act += units.newton_to_dyn(fn) * muscle_shares(model, name)
@@ -76,3 +76,15 @@ def load_program(model: Model, schedule: Schedule, source: str = "schedule") -> 
                        muscle_force=np.array([units.newton_to_dyn(e.force_n) for e in schedule.muscles]),
                        m_on=np.array([units.ms_to_s(e.onset_ms) for e in schedule.muscles]),
                        m_off=np.array([units.ms_to_s(e.onset_ms + e.duration_ms) for e in schedule.muscles]))
+
+
+def control_from_newtons(model: Model, muscles_n: dict[str, float] | None = None,
+                         loads_n: dict[str, tuple[float, float, float]] | None = None) -> Control:
+    """A step's control from muscle (or group) forces in N and loads in N on named node sets, each load
+    shared equally by its set's nodes."""
+    f = np.zeros((model.n_nodes, 3))
+    for name, total in (loads_n or {}).items():
+        idx = model.node_set(name)
+        f[idx] += units.newton_to_dyn(np.asarray(total, dtype=float)) / len(idx)
+    return Control(node_force=f, muscle_force=muscle_force_vector(model, muscles_n or {})
+                   if model.muscles is not None else None)

@@ -94,7 +94,7 @@ def carried_points(rest: np.ndarray, nodes: np.ndarray, frame: np.ndarray) -> Ca
 class Model:
     mesh: Mesh
     rest: np.ndarray  # (N,3) all nodes
-    cyl: CylinderSet
+    springs: CylinderSet  # every Voigt element: tongue cylinders, bone links, floor links and jaw springs
     bricks: np.ndarray
     brick_v0: np.ndarray
     kappa: np.ndarray  # (B,) bulk penalty, dyn/cm^2 (0 = constraint off)
@@ -168,8 +168,12 @@ class State:
 
 @dataclass(frozen=True)
 class Control:
-    force: np.ndarray  # (N,3) external nodal force, dyn
-    activation: np.ndarray | None = None  # (M,) muscle forces, dyn
+    """What drives one step: external nodal forces and the muscles' forces, both in dyn (1 N = 1e5 dyn).
+
+    Build one from newtons with :func:`artic_cli.mechanics.loads.control_from_newtons`."""
+
+    node_force: np.ndarray  # (N, 3) external force on each node, dyn
+    muscle_force: np.ndarray | None = None  # (M,) force of each muscle unit (model.muscle_names), dyn
 
 
 def rest_state(model: Model) -> State:
@@ -179,7 +183,7 @@ def rest_state(model: Model) -> State:
 
 
 def zero_control(model: Model) -> Control:
-    return Control(force=np.zeros((model.n_nodes, 3)), activation=np.zeros(len(model.muscle_names)))
+    return Control(node_force=np.zeros((model.n_nodes, 3)), muscle_force=np.zeros(len(model.muscle_names)))
 
 
 def solver_options(sim: Simulation) -> SolverOptions:
@@ -249,7 +253,7 @@ def _finish(mesh: Mesh, rest: np.ndarray, cyl: CylinderSet, link_mass: np.ndarra
         nodes, origin, normals, k, path, onset = guide
         extra["guide"] = Guide(nodes=nodes, origin=origin, normals=normals, stiffness=k, path=path, onset=onset)
         guide_flat = pattern.diagonal_operator(nodes) @ (k * np.einsum("gmi,gmj->gij", normals, normals)).ravel()
-    return Model(mesh=mesh, rest=rest, cyl=cyl, bricks=mesh.bricks, brick_v0=v0,
+    return Model(mesh=mesh, rest=rest, springs=cyl, bricks=mesh.bricks, brick_v0=v0,
                  kappa=kappa, mass=mass, node_mass=node_mass, gravity=np.array([0.0, -gravity, 0.0]), fixed=fixed,
                  pattern=pattern, assembly=asm, mass_flat=mass_flat, guide_flat=guide_flat,
                  scatter=scatter, options=solver_options(sim), **extra)

@@ -13,7 +13,7 @@ from threadpoolctl import threadpool_limits
 
 from ..geometry.hexahedra import corner_jacobians, volumes
 from .elements import strain_energy
-from .integrator import step, total_activation
+from .integrator import step, total_muscle_force
 from .model import Control, Model, State, rest_state, with_options, zero_control
 from .muscles import muscle_lengths, muscle_tensions
 from .volume import volume_energy
@@ -51,9 +51,9 @@ def mechanical_energy(model: Model, x: np.ndarray, v: np.ndarray) -> np.ndarray 
     t, n = xs.shape[:2]
     mv = (model.mass @ vs.transpose(1, 0, 2).reshape(n, -1)).reshape(n, t, 3).transpose(1, 0, 2)
     kinetic = 0.5 * (vs * mv).sum(axis=(1, 2))
-    d = xs[:, model.cyl.j] - xs[:, model.cyl.i]
-    strain = np.linalg.norm(d, axis=2) / model.cyl.l0 - 1.0
-    stored = np.array([strain_energy(model.cyl, s).sum() for s in strain])
+    d = xs[:, model.springs.j] - xs[:, model.springs.i]
+    strain = np.linalg.norm(d, axis=2) / model.springs.l0 - 1.0
+    stored = np.array([strain_energy(model.springs, s).sum() for s in strain])
     if model.volume_constraint:
         stored = stored + np.array([volume_energy(xi, model.bricks, model.brick_v0, model.kappa) for xi in xs])
     total = kinetic + stored
@@ -107,10 +107,10 @@ def run(model: Model, state: State, control_at: Callable[[float], Control], dura
 
     def record_muscles(st: State, act) -> None:
         if ms is not None:
-            m_force.append(muscle_tensions(ms, st.x, total_activation(model, act), st.sigma2))
+            m_force.append(muscle_tensions(ms, st.x, total_muscle_force(model, act), st.sigma2))
             m_len.append(muscle_lengths(ms, st.x))
 
-    record_muscles(state, control_at(state.t).activation if ms is not None else None)
+    record_muscles(state, control_at(state.t).muscle_force if ms is not None else None)
     w = 0.0
     gravity = model.node_mass[:, None] * model.gravity
     t0 = time.perf_counter()
@@ -119,7 +119,7 @@ def run(model: Model, state: State, control_at: Callable[[float], Control], dura
             ctl = control_at(state.t + 0.5 * h)  # inputs held over the step, sampled at its middle
             new = step(model, state, ctl, h)
             # work of the external forces (held over the step) and gravity
-            w += float(np.einsum("ij,ij->", ctl.force + gravity, new.x - state.x))
+            w += float(np.einsum("ij,ij->", ctl.node_force + gravity, new.x - state.x))
             state = new
             if k % record_every == 0 or k == n_steps:
                 times.append(state.t)
@@ -127,7 +127,7 @@ def run(model: Model, state: State, control_at: Callable[[float], Control], dura
                 vs.append(state.v.copy())
                 its.append(state.iterations)
                 work.append(w)
-                record_muscles(state, ctl.activation)
+                record_muscles(state, ctl.muscle_force)
                 c_nodes.append(state.contact_nodes)
                 c_forces.append(state.contact_force)
                 proj.append(state.projected)

@@ -30,7 +30,7 @@ def plot_simulation(traj, model, wall, path: Path | str, title: str = "") -> Pat
         frame_names = [f"{p}_{s}" for p in ("condyle", "coronoid", "gonion", "symphysis", "hyoid_body", "hyoid_horn")
                        for s in ("l", "r")]
         bones = np.array([model.names[n] for n in frame_names if n in model.names])
-        pairs = np.column_stack([model.cyl.i, model.cyl.j])
+        pairs = np.column_stack([model.springs.i, model.springs.j])
         pairs = pairs[np.isin(pairs, bones).all(axis=1) & (model.rest[pairs][:, :, 2] >= 0).all(axis=1)]
         for frame, colour, label in ((0, "#999999", "jaw and hyoid, start"), (-1, "#1f4e79", "jaw and hyoid, end")):
             for k, (a, b) in enumerate(pairs):
