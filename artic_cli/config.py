@@ -1,15 +1,15 @@
 """Configuration: YAML validated on load, with errors that name the key.
 
 Keys carry their unit in their name (``_cm``, ``_kpa``, ``_ms``, ``_n``) so a
-reader of a config never has to guess.  ``load_config`` is the only entry
-point; it returns a frozen :class:`Config` and its content hash.
+reader of a config never has to guess.  ``load_config`` reads and validates a
+file into a frozen :class:`Config`; :class:`ConfigView` restricts one to the
+top-level sections a stage declares, so a stage cannot depend on a section
+its freshness key leaves out.
 """
 
 from __future__ import annotations
 
 import difflib
-import hashlib
-import json
 from pathlib import Path
 from typing import Annotated, Literal
 
@@ -275,21 +275,31 @@ def load_config(path: Path | str | None = None) -> Config:
     return parse_config(read_yaml(path, "config"), path)
 
 
-def _digest(data) -> str:
-    blob = json.dumps(data, sort_keys=True, separators=(",", ":"))
-    return hashlib.sha256(blob.encode()).hexdigest()
+def parse_speaker(data: object, source: str = "<speaker>") -> Speaker:
+    try:
+        return Speaker.model_validate(data)
+    except ValidationError as err:
+        first = err.errors()[0]
+        raise ArticError(f"{source}: key 'speaker.{'.'.join(map(str, first['loc']))}': {first['msg']}") from None
 
 
-def config_hash(cfg: Config) -> str:
-    """Stable content hash (sha256 of canonical JSON) of a validated config."""
-    return _digest(cfg.model_dump(mode="json"))
+SECTIONS = tuple(Config.model_fields)
 
 
-def model_hash(cfg: Config) -> str:
-    """Hash of what a simulation depends on: everything but the experiment and map specifications."""
-    return _digest(cfg.model_dump(mode="json", exclude={"cuboid", "epmap", "muscle_function"}))
+class ConfigView:
+    """A config restricted to ``sections``: reading any other top-level section raises (a stage that did
+    that would go stale without noticing)."""
 
+    def __init__(self, cfg: Config, sections):
+        unknown = set(sections) - set(SECTIONS)
+        if unknown:
+            raise ValueError(f"unknown config sections {sorted(unknown)}")
+        if isinstance(cfg, ConfigView):
+            cfg = cfg.full
+        self.full, self.sections = cfg, frozenset(sections)
 
-def geometry_hash(cfg: Config) -> str:
-    """Hash of what the mesh depends on: the speaker's geometry only."""
-    return _digest(cfg.speaker.model_dump(mode="json"))
+    def __getattr__(self, name: str):
+        if name in SECTIONS and name not in self.sections:
+            raise AttributeError(f"config section '{name}' was not declared by this stage "
+                                 f"(declared: {', '.join(sorted(self.sections))})")
+        return getattr(self.full, name)

@@ -1,20 +1,29 @@
-"""Render a pipeline definition (``pipelines/*.yaml``) as make variables the Makefile includes.
+"""Render the Makefile's rules from the stage table (:mod:`artic_cli.stages.table`) and a pipeline
+definition (``pipelines/*.yaml``: which schedules, experiments and targets), and split a config into one
+file per section.
 
-    python -m artic_cli.pipeline pipelines/paper.yaml > data/.pipeline.mk
+    python -m artic_cli.pipeline rules pipelines/paper.yaml > data/.pipeline.mk
+    python -m artic_cli.pipeline sections configs/default.yaml data/.config
 
-Checks that every schedule, experiment and target it names exists, so a typo stops ``make`` at once
-with one line naming it.
+Every data rule depends on exactly what its stage reads: the artefacts before it, the config sections it
+declares (``{out}/.config/<section>.json``, rewritten only when that section changes) and the source files
+its module imports (plots and the CLI excluded).  A stage whose output comes out the same keeps the old
+file's time (see :mod:`artic_cli.io.store`); make's rule for it is a stamp, so nothing downstream reruns.
+Figures are rules of their own: a plotting edit redraws pictures and recomputes nothing.
 """
 
 from __future__ import annotations
 
+import importlib
+import json
 import sys
 from pathlib import Path
 
 from pydantic import BaseModel, ConfigDict, ValidationError
 
-from .config import read_yaml
+from .config import SECTIONS, load_config, read_yaml
 from .errors import ArticError
+from .io.fingerprint import module_closure, module_path
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -28,7 +37,6 @@ class Pipeline(BaseModel):
     animated: list[str] = []
     experiments: list[str] = []
     targets: list[str] = []
-    stages: dict[str, dict] = {}
 
 
 def load_pipeline(path: Path | str) -> Pipeline:
@@ -52,22 +60,120 @@ def load_pipeline(path: Path | str) -> Pipeline:
     return p
 
 
+def _files(*modules: str, plots: bool = False) -> list[str]:
+    """Source files of ``modules`` and what they import (for a plot module: everything it imports)."""
+    if plots:
+        from .io import fingerprint
+
+        seen, todo = set(), list(modules)
+        while todo:
+            m = todo.pop()
+            if m in seen:
+                continue
+            seen.add(m)
+            if module_path(m).name != "__init__.py" or m in modules:
+                todo.extend(fingerprint._imports(m) - seen)
+        names = sorted(seen)
+    else:
+        names = module_closure(*modules)
+    return [str(module_path(m).relative_to(ROOT)) for m in names]
+
+
+def _fill(text: str, **kw: str) -> str:
+    base = {"out": "$(OUT)", "report": "$(REPORT)", "config": "$(CONFIG)", "mesh": "$(OUT)/mesh.h5",
+            "maps": "$(OUT)/epmaps.h5", "dynamic": "$(OUT)/dynamic.h5"}
+    base.update(kw)
+    for _ in range(2):  # one level of nesting ({output} may hold {name})
+        text = text.format_map(_Keep(base))
+    return text
+
+
+class _Keep(dict):
+    def __missing__(self, key):
+        return "{" + key + "}"
+
+
 def render(p: Pipeline) -> str:
-    lines = [f"# generated from the {p.pipeline} pipeline definition; do not edit"]
-    for var, items in (("TISSUE_SIMS", p.tissue_schedules), ("NOVOL_SIMS", p.tissue_without_constraint),
-                       ("ART_SIMS", p.articulator_schedules), ("ANIMATED", p.animated),
-                       ("EXPS", p.experiments), ("TARGET_NAMES", p.targets)):
-        lines.append(f"{var} := {' '.join(items)}")
-    return "\n".join(lines) + "\n"
+    from .stages.table import REPORT_MODULE, REPORT_OUTPUT, STAGES
+
+    lines = [f"# generated from the stage table and the {p.pipeline} pipeline definition; do not edit", ""]
+    artefacts: list[str] = []
+    figures: list[str] = []
+    targets: dict[str, list[str]] = {}
+    for st in STAGES:
+        module = importlib.import_module(st.module)
+        sections = [f"$(OUT)/.config/{s}.json" for s in module.STAGE.sections]
+        src = " ".join(_files(st.module))
+        items = getattr(p, st.items) if st.items else [""]
+        outs = []
+        for name in items:
+            kw = {"name": name, "schedule": f"configs/schedules/{name}.yaml", "target": f"configs/targets/{name}.yaml"}
+            output = _fill(st.output, **kw)
+            kw["output"] = output
+            inputs = " ".join(_fill(i, **kw) for i in st.inputs)
+            stamp = f"$(OUT)/.stamps/{st.name}/{name or st.name}"
+            ok = " || [ $$? -eq 3 ]" if 3 in st.ok_status else ""
+            lines += [f"{stamp}: {inputs} {' '.join(sections)} {src} | setup".replace("  ", " "),
+                      f"\t$(ARTIC) {_fill(st.command, **kw)}{ok}",
+                      "\t@mkdir -p $(@D) && touch $@",
+                      f"{output}: {stamp} ; @test -f $@ || {{ rm -f $<; $(MAKE) --no-print-directory $< OUT=$(OUT) "
+                      "CONFIG=$(CONFIG) REPORT=$(REPORT); }", ""]
+            outs.append(output)
+            groups: dict[str, list] = {}  # one rule (grouped targets) per plotting command
+            for fig in st.figures:
+                if not fig.items or name in getattr(p, fig.items, [fig.items]):
+                    groups.setdefault(fig.command, []).append(fig)
+            for command, figs in groups.items():
+                paths = [_fill(f.path, **kw) for f in figs]
+                deps = sorted({_fill(i, **kw) for f in figs for i in f.inputs}
+                              | {x for f in figs for x in _files(f.module, plots=True)})
+                options = " ".join(_fill(f.option, **kw, figure=path) for f, path in zip(figs, paths))
+                lines += [f"{' '.join(paths)} &: {output} {' '.join(deps)} | setup",
+                          f"\t$(ARTIC) {_fill(command, **kw)} {options}", ""]
+                figures += paths
+        artefacts += outs
+        targets.setdefault(st.name.split("-")[0], []).extend(outs)
+    report = _fill(REPORT_OUTPUT)
+    lines += [f"{report}: {' '.join(artefacts)} {' '.join(figures)} {' '.join(_files(REPORT_MODULE))} | setup",
+              "\t$(ARTIC) report --data $(OUT) --out $@", ""]
+    for name, outs in targets.items():
+        lines.append(f"{name}: {' '.join(outs)}")
+    lines += [f"figures: {' '.join(figures)}", f"paper: {report}",
+              f".PHONY: {' '.join(targets)} figures paper", ""]
+    return "\n".join(lines)
+
+
+def split_sections(config: Path | str, folder: Path | str) -> list[str]:
+    """Write each section of a validated config (defaults filled in) to ``folder/<section>.json``; a file
+    whose section did not change is left alone (make sees nothing new).  Returns the sections rewritten."""
+    cfg = load_config(config)
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    changed = []
+    for s in SECTIONS:
+        if s == "schema_version":
+            continue
+        text = json.dumps(getattr(cfg, s).model_dump(mode="json"), sort_keys=True, indent=1) + "\n"
+        path = folder / f"{s}.json"
+        if not path.is_file() or path.read_text() != text:
+            tmp = path.with_suffix(".tmp")
+            tmp.write_text(text)
+            tmp.replace(path)
+            changed.append(s)
+    return changed
 
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
-    if len(argv) != 1:
-        print("usage: python -m artic_cli.pipeline PIPELINE.yaml", file=sys.stderr)
-        return 2
     try:
-        sys.stdout.write(render(load_pipeline(argv[0])))
+        if len(argv) == 2 and argv[0] == "rules":
+            sys.stdout.write(render(load_pipeline(argv[1])))
+        elif len(argv) == 3 and argv[0] == "sections":
+            split_sections(argv[1], argv[2])
+        else:
+            print("usage: python -m artic_cli.pipeline rules PIPELINE.yaml | sections CONFIG.yaml FOLDER",
+                  file=sys.stderr)
+            return 2
     except ArticError as err:
         print(f"error: {err}", file=sys.stderr)
         return 2

@@ -18,8 +18,9 @@ from pathlib import Path
 import yaml
 
 from artic_cli.config import load_config
-from artic_cli.control.epmap import build_ep_maps, plan
-from artic_cli.stages import build_mesh
+from artic_cli.control.epmap import plan
+from artic_cli.stages.epmap import build_ep_maps
+from artic_cli.stages.mesh import build_mesh
 
 ROOT = Path(__file__).resolve().parent.parent
 GOAL_S = 300.0

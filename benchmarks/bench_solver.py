@@ -15,8 +15,8 @@ from pathlib import Path
 import numpy as np
 
 from artic_cli.control.solver import parse_target
-from artic_cli.control.targets import load_context, solve, solve_batch
-from artic_cli.control.verify import Simulator
+from artic_cli.control.targets import solve, solve_batch
+from artic_cli.stages.solve import load_context, simulator
 
 ROOT = Path(__file__).resolve().parent.parent
 DATA = ROOT / "data"
@@ -55,7 +55,7 @@ def main() -> None:
     print(f"one target from the maps: median {1e3 * med:.1f} ms, max {1e3 * max(times):.1f} ms "
           f"(+ {1e3 * t_load:.0f} ms to load the maps once); goal < 200 ms -> {'met' if med + t_load < 0.2 else 'NOT MET'}"
           f"  [{solved}/100 reachable]")
-    sim = Simulator(mesh)
+    sim = simulator(mesh)
     reachable = [t for t in ts if _ok(ctx, t)][:5]
     t0 = time.perf_counter()
     solve(ctx, reachable[0], sim, verify=True, refine=True)
@@ -71,7 +71,7 @@ def main() -> None:
     solve_batch(ctx, ts, jobs=2)
     tb = time.perf_counter() - t0
     t0 = time.perf_counter()
-    solve_batch(ctx, ts, jobs=2, sim_args=(str(mesh), None), verify=True)
+    solve_batch(ctx, ts, jobs=2, sim_args=(sim.cfg, sim.mesh, sim.wall, sim.mesh_sha256), verify=True)
     tv = time.perf_counter() - t0
     print(f"batch of 100 targets: {tb:.2f} s from the maps, {tv:.1f} s with --verify on 2 workers; goal < 30 s -> "
           f"{'met' if max(tb, tv) < 30 else 'NOT MET'}")

@@ -11,7 +11,7 @@ from artic_cli.config import load_config
 from artic_cli.geometry.mesh import tongue_mesh
 from artic_cli.geometry.wall import wall_surface
 from artic_cli.mechanics.model import build_model
-from artic_cli.stages import build_mesh
+from artic_cli.stages.mesh import build_mesh
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -48,6 +48,14 @@ def art(cfg, mesh, wall):
 def mesh_file(tmp_path_factory):
     out = tmp_path_factory.mktemp("mesh") / "mesh.h5"
     build_mesh(ROOT / "configs" / "default.yaml", out)
+    return out
+
+
+@pytest.fixture(scope="session")
+def other_mesh_file(tmp_path_factory):
+    """A mesh of another speaker (configs/speaker_small.yaml): different content."""
+    out = tmp_path_factory.mktemp("other-mesh") / "mesh.h5"
+    build_mesh(ROOT / "configs" / "speaker_small.yaml", out)
     return out
 
 

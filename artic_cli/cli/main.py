@@ -1,7 +1,8 @@
-"""``artic``: build, simulate and validate the articulatory model.
+"""``artic``: the command line.
 
-Each command is a thin shell over :mod:`artic_cli.stages`; bad input ends in
-one line on stderr and exit status 2 (3 for an unreachable target).
+Each command is a thin shell over a stage module (:mod:`artic_cli.stages`) or
+a plot.  Exit statuses: 0 done, 2 bad input (one line on stderr), 3 target
+not reached (the answer is written), 130 interrupted.
 """
 
 from __future__ import annotations
@@ -11,6 +12,7 @@ import functools
 import json
 import sys
 from pathlib import Path
+from types import SimpleNamespace
 from typing import List, Optional
 
 import typer
@@ -18,12 +20,14 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 from rich.table import Table
 
-from ..errors import ArticError, UnreachableTarget
+from ..errors import ArticError
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
                   help="A physiological articulatory model of the tongue, jaw and hyoid (after Dang & Honda 2004).")
 validate_app = typer.Typer(no_args_is_help=True, help="Check the tissue model against the paper's test bodies.")
 app.add_typer(validate_app, name="validate", help="Check the tissue model against the paper's test bodies (cuboid).")
+plot_app = typer.Typer(no_args_is_help=True, help="Pictures of the artefacts.")
+app.add_typer(plot_app, name="plot", help="Pictures of the artefacts (mesh, simulations, maps, solutions, ...).")
 
 out_console = Console(width=None if sys.stdout.isatty() else 120)
 err_console = Console(stderr=True)
@@ -124,11 +128,14 @@ def build_mesh_cmd(
     plot: Optional[Path] = typer.Option(None, "--plot", help="Also draw the midsagittal view (PNG), like Fig. 1."),
 ):
     """Build the tongue mesh (bricks + cylinders) and the vocal-tract wall."""
-    from ..stages import build_mesh
+    from ..stages.mesh import build_mesh
 
-    s = build_mesh(config, out, plot)
+    s = build_mesh(config, out)
+    if plot:
+        _plot_mesh(out, plot)
     rel = abs(s.cylinder_volume_cm3 - s.volume_cm3) / s.volume_cm3
-    out_console.print(f"wrote {s.path}: {s.nodes} nodes, {s.bricks} bricks, {s.cylinders} cylinders, "
+    verb = f"{s.path} is up to date (same speaker geometry and code)" if s.up_to_date else f"wrote {s.path}"
+    out_console.print(f"{verb}: {s.nodes} nodes, {s.bricks} bricks, {s.cylinders} cylinders, "
                       f"tongue volume {s.volume_cm3:.3f} cm^3 (cylinders {s.cylinder_volume_cm3:.3f} cm^3, "
                       f"rel. diff {rel:.1e}), wall {s.wall_triangles} triangles"
                       + (f"; figure {plot}" if plot else ""), highlight=False)
@@ -151,11 +158,16 @@ def simulate_cmd(
     animate: Optional[Path] = typer.Option(None, "--animate", help="Also write a short animation (GIF)."),
 ):
     """Move the model under a schedule of muscle forces and loads; write trajectories."""
-    from ..stages import simulate
+    from ..stages.simulate import simulate
 
-    args = (schedule, duration, dt, mesh, config, out, volume_constraint, plot)
-    r = _with_progress("simulating", lambda update: simulate(*args, update, tongue_only=tongue_only, contact=contact,
-                                                             animate=animate))
+    args = (schedule, duration, dt, mesh, config, out, volume_constraint)
+    r = _with_progress("simulating", lambda update: simulate(*args, update, tongue_only=tongue_only, contact=contact))
+    if plot or animate:
+        _plot_simulation(r.path, r.model, r.wall, plot, animate)
+    if r.up_to_date:
+        out_console.print(f"{r.path} is up to date (same mesh, config sections, schedule, options and code); "
+                          f"max |volume change| {100 * r.max_volume_change:.3f} %", highlight=False)
+        return
     t = r.trajectory
     sim_time = t.time[-1] - t.time[0]
     out_console.print(
@@ -178,20 +190,16 @@ def validate_cuboid_cmd(
     """Pull the paper's 6 x 3 x 2 cm cuboid: strains, Poisson ratio (Eq. 4), volume change."""
     import math
 
-    from ..config import load_config
-    from ..experiments.cuboid import rows_as_dicts, run_cuboid
-
     if force is not None:
         bad = [f for f in force if not math.isfinite(f) or f < 0]
         if bad:
             raise ArticError(f"--force must be finite and non-negative (N), got {bad[0]}")
-    rows = run_cuboid(load_config(config), force, volume_constraint)
-    if out is not None:
-        from ..io.store import write_text_atomic
+    from ..stages.cuboid import validate_cuboid
 
-        write_text_atomic(out, json.dumps(rows_as_dicts(rows), indent=1))
+    dicts = validate_cuboid(config, force, volume_constraint, out)
+    rows = [SimpleNamespace(**d) for d in dicts]
     if as_json:
-        out_console.print_json(json.dumps(rows_as_dicts(rows)))
+        out_console.print_json(json.dumps(dicts))
         return
     table = Table(title="Cuboid 6 x 3 x 2 cm pulled along x (paper section II.B.3)",
                   caption="nu: Eq. (4) with engineering strains; nu log: Eq. (4) integrated (Hencky strains)")
@@ -215,23 +223,19 @@ def experiment_cmd(
     plot: Optional[Path] = typer.Option(None, "--plot", help="fig7 only: draw the trajectories (PNG)."),
 ):
     """Reproduce one of the paper's numeric experiments, ours beside the paper's."""
-    from ..config import config_hash
-    from ..experiments.paper import EXPERIMENTS, rows_as_dicts
-    from ..io.store import file_hash, write_text_atomic
-    from ..stages import load_model
+    from ..experiments.paper import EXPERIMENTS
+    from ..stages.experiments import run_experiment
 
     if name not in EXPERIMENTS:
         raise ArticError(f"unknown experiment '{name}'; valid: {', '.join(EXPERIMENTS)}")
     if plot is not None and name != "fig7":
         raise ArticError(f"--plot is for 'fig7'; experiment '{name}' prints a table only")
-    model, cfg, _ = load_model(mesh, config)
-    rows = EXPERIMENTS[name](model, plot=plot) if plot is not None else EXPERIMENTS[name](model)
-    if out is not None:
-        doc = {"experiment": name, "config_hash": config_hash(cfg), "mesh_sha256": file_hash(mesh),
-               "rows": rows_as_dicts(rows)}
-        write_text_atomic(out, json.dumps(doc, indent=1))
+    doc = run_experiment(name, mesh, config, out)
+    if plot is not None:
+        _plot_fig7(doc, plot)
+    rows = [SimpleNamespace(**r) for r in doc["rows"]]
     if as_json:
-        out_console.print_json(json.dumps(rows_as_dicts(rows)))
+        out_console.print_json(json.dumps(doc["rows"]))
         return
     _print_table(f"experiment {name}: ours beside Dang & Honda (2004)", ("quantity", "ours", "paper", "unit", "note"),
                  [(r.name, "n/a" if r.ours is None else f"{r.ours:.3g}", "" if r.paper is None else f"{r.paper:g}",
@@ -257,7 +261,7 @@ def ep_map_cmd(
     force: bool = typer.Option(False, "--force", help="Rewrite the map file even if it is up to date."),
 ):
     """Equilibrium-position maps at every jaw position (the paper's section IV.B), in parallel, resumable."""
-    from ..control.epmap import build_ep_maps
+    from ..stages.epmap import build_ep_maps
     from ..experiments.paper import PAPER_CONTRIBUTION
 
     with exit_on_interrupt(f"interrupted; {out} was not touched, finished equilibria are cached and a rerun "
@@ -271,7 +275,7 @@ def ep_map_cmd(
     out_console.print(f"wrote {r.path}: {r.total} equilibria ({r.computed} computed, {r.cached} from the cache) "
                       f"in {r.wall_time_s:.1f} s with {jobs} {backend} worker(s)", highlight=False)
     if r.unconverged:
-        out_console.print(f"[yellow]not settled (flagged 'converged = false' in the file, never used silently):[/] "
+        out_console.print("[yellow]not settled (flagged 'converged = false' in the file, never used silently):[/] "
                           + "; ".join(r.unconverged), highlight=False)
     else:
         out_console.print("every equilibrium settled (control points moved < tolerance over the last window)")
@@ -301,13 +305,18 @@ def muscle_function_cmd(
     plot_dir: Optional[Path] = typer.Option(None, "--plot-dir", help="Also draw Figs. 5 and 6 into this folder."),
 ):
     """Section IV.A.1: each muscle at 4 N for 150 ms from scattered starts (Figs. 5 and 6)."""
-    from ..experiments.muscle_function import build_muscle_function, convergence
+    from ..experiments.muscle_function import convergence
+    from ..stages.muscle_function import build_muscle_function
 
     with exit_on_interrupt(f"interrupted; {out} was not touched, finished starts are cached and a rerun resumes"):
-        mf, wall, cached, distinct = _with_progress(
+        mf, wall, cached, distinct, fresh = _with_progress(
             "starts", lambda update: build_muscle_function(mesh, config, out, jobs, cache, update), plain=True)
-    out_console.print(f"wrote {out}: {len(mf.starts)} starts ({distinct} distinct force sets, {cached} from the "
-                      f"cache) x {len(mf.muscles)} muscles in {wall:.1f} s", highlight=False)
+    if fresh:
+        out_console.print(f"{out} is up to date (same mesh, config sections and code): {len(mf.starts)} starts x "
+                          f"{len(mf.muscles)} muscles", highlight=False)
+    else:
+        out_console.print(f"wrote {out}: {len(mf.starts)} starts ({distinct} distinct force sets, {cached} from the "
+                          f"cache) x {len(mf.muscles)} muscles in {wall:.1f} s", highlight=False)
     table = Table(title=f"Where each muscle drives the control points ({mf.drive_n:g} N, {mf.drive_ms:g} ms)")
     for col in ("muscle", "point", "start spread cm", "end spread cm", "mean end - rest, x / y cm"):
         table.add_column(col, justify="left" if col in ("muscle", "point") else "right")
@@ -323,6 +332,25 @@ def muscle_function_cmd(
             out_console.print(f"wrote {plot_muscle_function(mf, point, Path(plot_dir) / fig)}", highlight=False)
 
 
+@plot_app.command("muscle-function")
+@handle_errors
+def plot_muscle_function_cmd(
+    study: Path = typer.Argument(Path("data/muscle_function.h5"), help="Result of 'artic muscle-function'."),
+    tip: Optional[Path] = typer.Option(None, "--tip", help="Fig. 5: the tip (PNG)."),
+    dorsum: Optional[Path] = typer.Option(None, "--dorsum", help="Fig. 6: the dorsum (PNG)."),
+):
+    """Figs. 5 and 6: where each muscle drives the tip and the dorsum from scattered starts."""
+    from ..plots.muscle_function import plot_muscle_function
+    from ..stages.muscle_function import read
+
+    if tip is None and dorsum is None:
+        raise ArticError("nothing to draw; give --tip PNG and/or --dorsum PNG")
+    mf = read(study)
+    for point, path in (("tip", tip), ("dorsum", dorsum)):
+        if path is not None:
+            out_console.print(f"wrote {plot_muscle_function(mf, point, path)}", highlight=False)
+
+
 @app.command("dynamic-map")
 @handle_errors
 def dynamic_map_cmd(
@@ -331,7 +359,8 @@ def dynamic_map_cmd(
     as_json: bool = typer.Option(False, "--json", help="Print Table IV as JSON."),
 ):
     """Derive the map of any jaw position from the typical one (rotation + translation); Table IV."""
-    from ..control.dynamic import build_dynamic_map, table_iv
+    from ..control.dynamic import table_iv
+    from ..stages.dynamic import build_dynamic_map
 
     dm = build_dynamic_map(maps, out)
     rows = table_iv(dm)
@@ -370,17 +399,19 @@ def solve_target_cmd(
     config: Optional[Path] = typer.Option(None, "--config", help="Config for --verify / --refine."),
 ):
     """Muscle forces that put the crucial feature on its target and approach the others (section V)."""
-    from ..control.targets import batch_csv, load_context, load_target, read_batch, solve, solve_batch, write_solution
+    from ..control.targets import batch_csv, load_target, read_batch, solve_batch
     from ..io.store import write_text_atomic
+    from ..stages.solve import load_context, simulator, solve_target
 
     if (target is None) == (batch is None):
         raise ArticError("give a target file or --batch CSV (one of them)")
     if budget < 1:
         raise ArticError(f"--budget must be at least 1, got {budget}")
     ctx = load_context(maps, dynamic, mesh if (verify or refine) else None)
+    sim = simulator(mesh, config) if (verify or refine) else None
     if batch is not None:
         targets = read_batch(batch)
-        args = (str(mesh), None if config is None else str(config))
+        args = None if sim is None else (sim.cfg, sim.mesh, sim.wall, sim.mesh_sha256)
         res = _with_progress("targets", lambda update: solve_batch(ctx, targets, jobs, args, verify, refine, budget,
                                                                    update), plain=True)
         path = out or Path("data/solutions") / f"{batch.stem}.csv"
@@ -390,18 +421,10 @@ def solve_target_cmd(
                           highlight=False)
         return
     t = load_target(target)
-    sim = None
-    if verify or refine:
-        from ..control.verify import Simulator
-
-        sim = Simulator(mesh, config)
-    path = out or Path("data/solutions") / f"{t.name}.yaml"
-    try:
-        doc = solve(ctx, t, sim, verify, refine, budget)
-    except UnreachableTarget as err:  # the answer is written too (make and scripts can report it)
-        write_solution(path, {"target": t.name, "unreachable": str(err)})
-        raise
-    write_solution(path, doc)
+    doc, path, fresh = solve_target(t, ctx, out, sim, verify, refine, budget, config,
+                                    "" if sim is None else sim.mesh_sha256)
+    if fresh:
+        out_console.print(f"{path} is up to date (same maps, target, options and code)", highlight=False)
     ch = doc["chosen"]
     forces = ", ".join(f"{k} {v:g} N" for k, v in ch["forces_n"].items())
     out_console.print(f"{t.name}: {ch['family']} {ch['map']}: {forces}; predicted tip {ch['predicted_cm']['tip']}, "
@@ -436,7 +459,7 @@ def export_cmd(
     every: int = typer.Option(1, "--every", help="Export every n-th recorded frame (VTK)."),
 ):
     """Write the mesh and simulations for ParaView (VTK/XDMF) and control points as CSV (EMA layout)."""
-    from ..io.export import export_csv, export_mesh_vtk, export_simulation_vtk
+    from ..stages.export import export_csv, export_mesh_vtk, export_simulation_vtk
 
     if vtk is None and csv_out is None:
         raise ArticError("nothing to export; give --vtk FOLDER and/or --csv FILE")
@@ -455,8 +478,6 @@ def export_cmd(
     out_console.print(f"wrote {shown}", highlight=False)
 
 
-plot_app = typer.Typer(no_args_is_help=True, help="Pictures of the artefacts.")
-app.add_typer(plot_app, name="plot", help="Pictures of the artefacts (EP maps, ...).")
 
 
 @plot_app.command("ep-map")
@@ -469,8 +490,8 @@ def plot_ep_map_cmd(
     out: Path = typer.Option(Path("reports/epmap.png"), "--out", help="Picture to write (PNG)."),
 ):
     """Fig. 8: EP vectors of the tip and dorsum, with one two-muscle contour net."""
-    from ..control.epmap import load_ep_maps
     from ..plots.epmap import plot_ep_map
+    from ..stages.epmap import load_ep_maps
 
     m = load_ep_maps(maps)
     path = plot_ep_map(m, jaw, pair, out)
@@ -486,9 +507,9 @@ def plot_dynamic_map_cmd(
     out: Path = typer.Option(Path("reports/fig9_dynamic_map.png"), "--out", help="Picture to write (PNG)."),
 ):
     """Fig. 9: a jaw position's EP vectors, simulated and derived from the typical map."""
-    from ..control.dynamic import load_dynamic_map
-    from ..control.epmap import load_ep_maps
     from ..plots.dynamic import plot_dynamic_map
+    from ..stages.dynamic import load_dynamic_map
+    from ..stages.epmap import load_ep_maps
 
     m = load_ep_maps(maps)
     dm = load_dynamic_map(dynamic, maps_path=maps)
@@ -506,8 +527,9 @@ def plot_solution_cmd(
 ):
     """Fig. 12: targets, the candidate force sets' predicted positions and the chosen one."""
     from ..config import read_yaml
-    from ..control.targets import jaw_maps, load_context, load_target
+    from ..control.targets import jaw_maps, load_target
     from ..plots.solution import plot_solution
+    from ..stages.solve import load_context
 
     doc = read_yaml(solution, "solution file")
     if not isinstance(doc, dict) or not ("chosen" in doc or "unreachable" in doc):
@@ -526,10 +548,84 @@ def report_cmd(
     out: Path = typer.Option(Path("reports/paper.md"), "--out", help="Report to write (Markdown)."),
 ):
     """Write the report that sets our results beside the paper's."""
-    from ..report import write_report
+    from ..stages.report import write_report
 
     path = write_report(data, out)
     out_console.print(f"wrote {path}", highlight=False)
+
+
+def _plot_mesh(mesh: Path, out: Path) -> Path:
+    from ..plots.mesh import plot_mesh
+    from ..stages.mesh import read
+
+    m = read(mesh)
+    return plot_mesh(m.mesh, m.wall, m.speaker.landmarks_cm, out)
+
+
+def _plot_simulation(sim: Path, model, wall, plot: Path | None, animate: Path | None) -> None:
+    from ..stages.simulate import read
+
+    s = read(sim)
+    traj = SimpleNamespace(x=s.positions_cm, time=s.time_s)
+    if plot:
+        from ..plots.simulation import plot_simulation
+
+        plot_simulation(traj, model, wall, plot, title=f"{Path(sim).stem}: start and end shapes")
+    if animate:
+        from ..plots.animation import animate_simulation
+
+        animate_simulation(traj, model, wall, animate)
+
+
+def _plot_fig7(doc: dict, out: Path) -> Path:
+    from ..plots.muscle_function import plot_fig7
+    from ..stages.experiments import figure_paths
+
+    if "figure" not in doc:
+        raise ArticError(f"experiment '{doc.get('experiment')}' has no figure; only fig7 draws one")
+    return plot_fig7(figure_paths(doc), out)
+
+
+@plot_app.command("mesh")
+@handle_errors
+def plot_mesh_cmd(
+    mesh: Path = typer.Option(Path("data/mesh.h5"), "--mesh", help="Mesh artefact from build-mesh."),
+    out: Path = typer.Option(Path("reports/fig1_mesh.png"), "--out", help="Picture to write (PNG)."),
+):
+    """Fig. 1: the mesh, the wall and the muscles' landmarks, midsagittal and lateral."""
+    out_console.print(f"wrote {_plot_mesh(mesh, out)}", highlight=False)
+
+
+@plot_app.command("simulation")
+@handle_errors
+def plot_simulation_cmd(
+    sim: Path = typer.Argument(..., help="A simulation from 'artic simulate' (HDF5)."),
+    mesh: Path = typer.Option(Path("data/mesh.h5"), "--mesh", help="The mesh it was run on."),
+    config: Optional[Path] = typer.Option(None, "--config", help="The config it was run with."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Start and end shapes (PNG)."),
+    animate: Optional[Path] = typer.Option(None, "--animate", help="An animation (GIF)."),
+):
+    """Start and end shapes of a simulation (Fig. 4 style) and/or its animation."""
+    from ..stages.simulate import load_model, read
+
+    if out is None and animate is None:
+        raise ArticError("nothing to draw; give --out PNG and/or --animate GIF")
+    tongue_only = bool(read(sim).attrs.get("tongue_only", False))
+    model, _, wall = load_model(mesh, config, tongue_only=tongue_only)
+    _plot_simulation(sim, model, wall, out, animate)
+    out_console.print("wrote " + ", ".join(str(p) for p in (out, animate) if p), highlight=False)
+
+
+@plot_app.command("experiment")
+@handle_errors
+def plot_experiment_cmd(
+    table: Path = typer.Argument(..., help="An experiment table from 'artic experiment fig7 --out FILE'."),
+    out: Path = typer.Option(Path("reports/fig7_trajectories.png"), "--out", help="Picture to write (PNG)."),
+):
+    """Fig. 7: the trajectories from four starting shapes (from the fig7 table)."""
+    from ..stages.experiments import read
+
+    out_console.print(f"wrote {_plot_fig7(read(table), out)}", highlight=False)
 
 
 def main() -> None:  # pragma: no cover - console entry

@@ -14,15 +14,12 @@ not.
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass, replace
-from pathlib import Path
 
 import numpy as np
 
 from ..errors import ArticError
-from ..io.store import atomic_h5, file_hash, open_artifact
-from .epmap import EPMaps, JawMaps, Net, load_ep_maps
+from .epmap import EPMaps, JawMaps, Net
 
 CPS = ("tip", "dorsum")
 PAPER_TABLE_IV = {"JC_3": (0.407, 0.037, 0.030), "JC_1.5": (0.210, 0.026, 0.024), "JC_0.5": (0.090, 0.021, 0.020),
@@ -164,46 +161,6 @@ def derive(maps: EPMaps, dm: DynamicMap, jaw_height: float) -> JawMaps:
     rest[2, 1] = jaw_height
     return JawMaps(forces={}, rest=rest, single={m: move(n) for m, n in typ.single.items()},
                    pair={m: move(n) for m, n in typ.pair.items()}, group={m: move(n) for m, n in typ.group.items()})
-
-
-def write_dynamic_map(path: Path | str, dm: DynamicMap, maps_path: Path | str) -> None:
-    with atomic_h5(path, "dynamic-map") as f:
-        f.attrs.update({"maps_sha256": file_hash(maps_path), "typical_jaw": dm.typical,
-                        "jaw_forces_n": json.dumps(dm.jaw_forces), "rest_height_cm": dm.rest_height,
-                        "model": "x' = R(theta) (x - centre) + centre + shift per control point; theta and shift "
-                                 "piecewise linear in the jaw's incisor height"})
-        f.create_dataset("jaw_positions", data=np.array(dm.jaws, dtype="S"))
-        for name, data, unit in (("incisor_height", dm.height, "cm"), ("jaw_angle", np.degrees(dm.angle), "deg"),
-                                 ("theta", np.degrees(dm.theta), "deg, columns tip, dorsum"),
-                                 ("shift", dm.shift, "cm, (jaw, control point, xy)"),
-                                 ("centre", dm.centre, "cm, (control point, xy)"),
-                                 ("error_mean", dm.error_mean, "cm"), ("error_max", dm.error_max, "cm"),
-                                 ("loo_error_mean", dm.loo_error_mean, "cm, leave-one-out"),
-                                 ("points", dm.points, "EPs compared")):
-            f.create_dataset(name, data=data).attrs["units"] = unit
-
-
-def load_dynamic_map(path: Path | str, maps_path: Path | str | None = None) -> DynamicMap:
-    hint = "rebuild it with 'artic dynamic-map'"
-    with open_artifact(path, "dynamic-map", hint) as f:
-        try:
-            if maps_path is not None and f.attrs["maps_sha256"] != file_hash(maps_path):
-                raise ArticError(f"{path} was derived from other EP maps than {maps_path}; {hint}")
-            return DynamicMap(typical=str(f.attrs["typical_jaw"]),
-                              jaws=[j.decode() for j in f["jaw_positions"][()]],
-                              jaw_forces=json.loads(f.attrs["jaw_forces_n"]), height=f["incisor_height"][()],
-                              angle=np.radians(f["jaw_angle"][()]), theta=np.radians(f["theta"][()]),
-                              shift=f["shift"][()], centre=f["centre"][()], error_mean=f["error_mean"][()],
-                              error_max=f["error_max"][()], loo_error_mean=f["loo_error_mean"][()],
-                              points=f["points"][()], rest_height=float(f.attrs["rest_height_cm"]))
-        except (KeyError, ValueError, OSError) as err:
-            raise ArticError(f"{path} is damaged or incomplete ({type(err).__name__}); {hint}") from None
-
-
-def build_dynamic_map(maps: Path | str = "data/epmaps.h5", out: Path | str = "data/dynamic.h5") -> DynamicMap:
-    dm = fit_dynamic_map(load_ep_maps(maps))
-    write_dynamic_map(out, dm, maps)
-    return dm
 
 
 def table_iv(dm: DynamicMap) -> list[dict]:

@@ -1,4 +1,4 @@
-"""The solve-target stage: target file in, force set out (with checks), one target or a batch."""
+"""Solving targets on EP maps: a target in, a force set out (with checks and refinement), one or a batch."""
 
 from __future__ import annotations
 
@@ -9,13 +9,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import yaml
 
 from ..config import read_yaml
 from ..errors import ArticError, UnreachableTarget
-from ..io.store import file_hash, write_text_atomic
-from .dynamic import DynamicMap, derive, load_dynamic_map
-from .epmap import EPMaps, JawMaps, canonical, load_ep_maps
+from .dynamic import DynamicMap, derive
+from .epmap import EPMaps, JawMaps, canonical
 from .solver import Candidate, TargetSpec, parse_target, solve_on
 
 TOP = 5  # candidates listed in the output
@@ -25,19 +23,12 @@ REFINE_TRIES = 3  # candidates --refine may try in turn
 
 @dataclass
 class Context:
+    """What a target is solved on: the EP maps and (optionally) the dynamic map, with their content hashes."""
+
     maps: EPMaps
     dm: DynamicMap | None
-    maps_path: str
-    dynamic_path: str | None
-
-
-def load_context(maps: Path | str = "data/epmaps.h5", dynamic: Path | str | None = "data/dynamic.h5",
-                 mesh: Path | str | None = None) -> Context:
-    m = load_ep_maps(maps, mesh=mesh)
-    dm = None
-    if dynamic is not None and Path(dynamic).is_file():
-        dm = load_dynamic_map(dynamic, maps_path=maps)
-    return Context(maps=m, dm=dm, maps_path=str(maps), dynamic_path=None if dm is None else str(dynamic))
+    maps_sha256: str = ""
+    dynamic_sha256: str | None = None
 
 
 def jaw_maps(ctx: Context, target: TargetSpec) -> tuple[JawMaps, dict[str, float], float, str]:
@@ -131,17 +122,11 @@ def solve(ctx: Context, target: TargetSpec, simulator=None, verify: bool = False
                                              "dorsum": [_num(v) for v in r.reached[1, :2]]},
                               "crucial_error_cm": _num(r.error), "simulations": budget - left,
                               "converged": bool(r.error <= target.crucial.tolerance_cm)}
-    doc["provenance"] = {"epmaps_sha256": file_hash(ctx.maps_path),
-                         "dynamic_sha256": None if ctx.dynamic_path is None else file_hash(ctx.dynamic_path)}
     return doc
 
 
 def load_target(path: Path | str) -> TargetSpec:
     return parse_target(read_yaml(path, "target file"), str(path))
-
-
-def write_solution(path: Path | str, doc: dict) -> Path:
-    return write_text_atomic(path, yaml.safe_dump(doc, sort_keys=False))
 
 
 # --- batches -----------------------------------------------------------------------------------------
@@ -209,7 +194,9 @@ def _solve_row(ctx: Context, target: TargetSpec, sim_args, verify: bool, refine:
 
 def solve_batch(ctx: Context, targets: list[TargetSpec], jobs: int = 2, sim_args=None, verify: bool = False,
                 refine: bool = False, budget: int = 8, progress=None) -> list[dict]:
-    from joblib import Parallel, delayed
+    """Every target of a batch; with ``verify``/``refine`` in parallel (``sim_args``: what
+    :class:`~artic_cli.control.verify.Simulator` is built from in each worker)."""
+    from ..parallel import Sweep, run_sweep
 
     if not (verify or refine):  # map look-ups only: cheaper in this process than shipping the maps
         out = []
@@ -218,18 +205,8 @@ def solve_batch(ctx: Context, targets: list[TargetSpec], jobs: int = 2, sim_args
             if progress:
                 progress(k + 1, len(targets))
         return out
-    results = [None] * len(targets)
-    gen = Parallel(n_jobs=jobs, return_as="generator_unordered")(
-        delayed(_indexed)(k, ctx, t, sim_args, verify, refine, budget) for k, t in enumerate(targets))
-    for n, (k, doc) in enumerate(gen, start=1):
-        results[k] = doc
-        if progress:
-            progress(n, len(targets))
-    return results
-
-
-def _indexed(k, *args):
-    return k, _solve_row(*args)
+    calls = [(ctx, t, sim_args, verify, refine, budget) for t in targets]
+    return run_sweep(_solve_row, calls, Sweep(jobs=jobs, progress=progress)).results
 
 
 def batch_csv(results: list[dict]) -> str:

@@ -12,14 +12,16 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
-from ..config import Config, load_config, model_hash
-from ..io.store import file_hash
-from .epmap import (CONTROL_POINTS, JawMaps, add_forces, canonical, equilibrium_point, worker_model,
-                    worker_rest)
+from ..config import Config
+from ..geometry.mesh import Mesh
+from ..geometry.wall import WallSurface
+from ..io.fingerprint import code_hash, digest, sections_hash
+from ..mechanics.model import ARTICULATOR_SECTIONS, CONTROL_POINTS
+from .epmap import JawMaps, add_forces, canonical
+from .equilibrium import equilibrium_point, worker_model, worker_rest
 from .solver import Candidate
 
 MAX_STEP_N = 1.5  # largest change of one force per refinement step
@@ -28,16 +30,17 @@ MAX_STEP_N = 1.5  # largest change of one force per refinement step
 class Simulator:
     """The articulator of a mesh and config, with each jaw position's rest computed once (per process)."""
 
-    def __init__(self, mesh: Path | str, config: Path | str | None = None):
-        self.cfg: Config = load_config(config)
-        self.mesh = str(mesh)
-        self.key = model_hash(self.cfg) + file_hash(mesh)
-        self.cfg_json = json.dumps(self.cfg.model_dump(mode="json"))
+    def __init__(self, cfg: Config, mesh: Mesh, wall: WallSurface, mesh_sha256: str):
+        self.cfg = cfg
+        self.mesh, self.wall, self.mesh_sha256 = mesh, wall, mesh_sha256
+        self.key = digest({"sections": sections_hash(cfg, ARTICULATOR_SECTIONS), "mesh": mesh_sha256,
+                           "code": code_hash("artic_cli.control.equilibrium")})
+        self.cfg_json = json.dumps(cfg.model_dump(mode="json"))
 
     def reach(self, jaw_forces: dict[str, float], forces: dict[str, float]) -> np.ndarray:
         """(3, 3) tip, dorsum, jaw (cm) after holding the forces from the jaw position's rest."""
-        model = worker_model(self.key, self.cfg_json, self.mesh)
-        start = worker_rest(self.key, canonical(jaw_forces), self.cfg_json, self.mesh)
+        model = worker_model(self.key, self.cfg_json, self.mesh, self.wall)
+        start = worker_rest(self.key, canonical(jaw_forces), self.cfg_json, self.mesh, self.wall)
         return equilibrium_point(model, start, add_forces(dict(jaw_forces), forces), self.cfg.epmap).x
 
 

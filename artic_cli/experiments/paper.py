@@ -12,8 +12,8 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from ..mechanics.contact import wall_query
-from ..mechanics.loads import muscle_force_vector
-from ..mechanics.model import Control, Model
+from ..mechanics.loads import control_from_newtons
+from ..mechanics.model import Model
 from ..mechanics.simulate import run, settle
 
 PAPER_JAW_EP = {"JO": ((0.5, -0.16), (1.2, -0.37), (2.5, -0.76), (4.0, -1.10), (6.0, -1.42)),
@@ -54,10 +54,6 @@ class Row:
     note: str = ""
 
 
-def _control(model: Model, forces_n: dict[str, float]) -> Control:
-    return Control(node_force=np.zeros((model.n_nodes, 3)), muscle_force=muscle_force_vector(model, forces_n))
-
-
 class Audit:
     """Worst volume change, wall penetration and inverted-brick count over every run of an experiment."""
 
@@ -69,7 +65,7 @@ class Audit:
         self.runs = 0
 
     def run(self, rest, forces_n: dict[str, float], duration: float):
-        ctl = _control(self.model, forces_n)
+        ctl = control_from_newtons(self.model, forces_n)
         traj, end = run(self.model, rest, lambda t: ctl, duration)
         self.runs += 1
         self.volume = max(self.volume, float(np.abs(traj.volume_change).max()))
@@ -87,13 +83,9 @@ class Audit:
                 Row("inverted bricks (most in any frame)", float(self.inverted), 0.0, "count")]
 
 
-def _points(model: Model) -> dict[str, int]:
-    return {k: int(model.node_sets[k][0]) for k in ("tip", "dorsum", "jaw")}
-
-
 def jaw_ep(model: Model, duration: float = 0.3) -> list[Row]:
     rest = settle(model)
-    jaw = _points(model)["jaw"]
+    jaw = model.control_points()["jaw"]
     audit = Audit(model)
     rows = []
     for group, pairs in PAPER_JAW_EP.items():
@@ -106,7 +98,7 @@ def jaw_ep(model: Model, duration: float = 0.3) -> list[Row]:
 
 def fig4(model: Model) -> list[Row]:
     rest = settle(model)
-    pts = _points(model)
+    pts = model.control_points()
     audit = Audit(model)
     rows = []
     for muscle in ("GGp", "SG"):
@@ -122,7 +114,7 @@ def fig4(model: Model) -> list[Row]:
 
 def muscle_directions(model: Model, force: float = 4.0, duration: float = 0.3) -> list[Row]:
     rest = settle(model)
-    pts = _points(model)
+    pts = model.control_points()
     audit = Audit(model)
     rows = []
     for muscle in ("GGa", "GGm", "GGp", "HG", "SG", "SL", "IL", "T", "V", "GH", "MH", "T-SL"):
@@ -145,7 +137,7 @@ def k_closure(model: Model, forces=(0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0, 4.0), d
     """Smallest SG force at which the dorsum region touches the palate (jaw at rest)."""
     rest = settle(model)
     dorsum_region = set(model.node_sets["dorsum_region"].tolist())
-    dorsum = _points(model)["dorsum"]
+    dorsum = model.control_points()["dorsum"]
     audit = Audit(model)
     found, gap = None, None
     for force in forces:
@@ -177,7 +169,7 @@ def fig7_paths(model: Model, muscles=("GGp", "GGm", "SG"), forces=(1.0, 2.0, 3.5
     shapes (two-muscle combinations at 5 N each, 300 ms) under that force alone; and the audit."""
     rest = settle(model)
     audit = Audit(model)
-    watch = [int(model.node_sets[k][0]) for k in ("tip", "dorsum", "jaw")]
+    watch = list(model.control_points().values())
     starts = [audit.run(rest, {m: 5.0 for m in combo}, 0.3)[1] for combo in FIG7_STARTS]
     data = {}
     for muscle in muscles:
@@ -187,8 +179,9 @@ def fig7_paths(model: Model, muscles=("GGp", "GGm", "SG"), forces=(1.0, 2.0, 3.5
 
 
 def fig7(model: Model, muscles=("GGp", "GGm", "SG"), forces=(1.0, 2.0, 3.5, 5.0), duration: float = 0.4,
-         plot=None) -> list[Row]:
-    """Fig. 7: one muscle from four different starting shapes reaches one EP per force level."""
+         figure: dict | None = None) -> list[Row]:
+    """Fig. 7: one muscle from four different starting shapes reaches one EP per force level; ``figure``
+    (a dict) receives the paths for the picture."""
     data, audit = fig7_paths(model, muscles, forces, duration)
     rows = []
     for muscle, d in data.items():
@@ -200,10 +193,8 @@ def fig7(model: Model, muscles=("GGp", "GGm", "SG"), forces=(1.0, 2.0, 3.5, 5.0)
                 rows.append(Row(f"{muscle} {force:g} N {cp}: spread of the four end points", spread, None, "cm",
                                 f"starts {' / '.join('+'.join(cb) for cb in FIG7_STARTS)} at 5 N; "
                                 f"each moved at least {moved:.2f} cm"))
-    if plot is not None:
-        from ..plots.muscle_function import plot_fig7
-
-        plot_fig7(data, plot)
+    if figure is not None:
+        figure.update(data)
     return rows + audit.rows()
 
 

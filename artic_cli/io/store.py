@@ -1,19 +1,23 @@
-"""Artefacts on disk: HDF5 written atomically, read back with checks.
+"""Artefacts on disk: written atomically with their provenance, read back with checks.
 
-Every artefact carries ``kind``, ``schema_version``, ``package_version``,
-``config_hash`` and ``created`` attributes at its root.  Writing goes to a
-temporary file beside the target, renamed over it only when complete, so an
-interrupted run never leaves a half-written file a later stage would trust.
-Lengths are stored in cm, forces in N, times in s; each dataset says so in
-its ``units`` attribute.
+Every HDF5 artefact carries at its root ``kind``, ``schema_version`` and ``content_sha256`` (a hash of what
+it holds: :func:`artic_cli.io.fingerprint.h5_content_hash`), and its provenance: ``recipe_sha256`` (the
+stage, the config sections it read, the content hashes of the artefacts it read, its code and its
+parameters), ``inputs_json`` and ``created``.  Writing goes to a temporary file beside the target, renamed
+over it only when complete, so an interrupted run never leaves a half-written file a later stage would
+trust.  A rewrite whose content equals the file it replaces keeps that file's modification time, so
+``make`` sees nothing new downstream.  Lengths are stored in cm, forces in N, times in s; each dataset says
+so in its ``units`` attribute.
 """
 
 from __future__ import annotations
 
 import contextlib
 import datetime as _dt
+import json
 import os
 import tempfile
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Iterator
 
@@ -21,12 +25,36 @@ import h5py
 import numpy as np
 
 from .. import __version__
-from ..config import Config, config_hash, geometry_hash, parse_config
+from ..config import Speaker, parse_speaker
 from ..errors import ArticError
 from ..geometry.mesh import Mesh
 from ..geometry.wall import PARTS, WallSurface
+from .fingerprint import digest, h5_content_hash
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
+
+
+@dataclass(frozen=True)
+class Provenance:
+    """What an artefact was made from: the stage, its config sections' hash, its inputs' content hashes,
+    its code's hash and its parameters.  ``recipe`` hashes all of them: equal recipes, equal results."""
+
+    stage: str
+    sections_sha256: str = ""
+    inputs: dict = field(default_factory=dict)  # name -> content_sha256 of an artefact (or of a user file)
+    code_sha256: str = ""
+    params: dict = field(default_factory=dict)
+
+    @property
+    def recipe(self) -> str:
+        return digest({"stage": self.stage, "sections": self.sections_sha256, "inputs": self.inputs,
+                       "code": self.code_sha256, "params": self.params, "schema": SCHEMA_VERSION})
+
+    def attrs(self) -> dict:
+        return {"recipe_sha256": self.recipe, "config_sections_sha256": self.sections_sha256,
+                "code_sha256": self.code_sha256, "inputs_json": json.dumps(self.inputs, sort_keys=True),
+                "package_version": __version__,
+                "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")}
 
 
 def _umask() -> int:
@@ -36,8 +64,9 @@ def _umask() -> int:
 
 
 @contextlib.contextmanager
-def atomic_path(path: Path | str, suffix: str = ".tmp") -> Iterator[Path]:
-    """A temporary file beside ``path`` that replaces it (with ordinary permissions) only on success."""
+def atomic_path(path: Path | str, suffix: str = ".tmp", same_content=None) -> Iterator[Path]:
+    """A temporary file beside ``path`` that replaces it (with ordinary permissions) only on success.
+    ``same_content(old, new)``: when it says the two hold the same, the old file's mtime is kept."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
@@ -45,22 +74,82 @@ def atomic_path(path: Path | str, suffix: str = ".tmp") -> Iterator[Path]:
     try:
         yield Path(tmp)
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; artefacts are for sharing
+        keep = None
+        if same_content is not None and path.is_file():
+            with contextlib.suppress(Exception):
+                if same_content(path, Path(tmp)):
+                    st = path.stat()
+                    keep = (st.st_atime_ns, st.st_mtime_ns)
         os.replace(tmp, path)
+        if keep is not None:
+            os.utime(path, ns=keep)
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
         raise
 
 
+def _is_h5(path: Path) -> bool:
+    with open(path, "rb") as fh:
+        return fh.read(8) == b"\x89HDF\r\n\x1a\n"
+
+
+def stored_content_hash(path: Path | str) -> str | None:
+    """The ``content_sha256`` an artefact records (HDF5 root attribute or JSON/YAML ``provenance``), or None."""
+    path = Path(path)
+    try:
+        if _is_h5(path):
+            with h5py.File(path, "r") as f:
+                v = f.attrs.get("content_sha256")
+                return None if v is None else str(v)
+        doc = _read_doc(path)
+        return (doc.get("provenance") or {}).get("content_sha256") if isinstance(doc, dict) else None
+    except Exception:  # noqa: BLE001 - unreadable: no usable hash
+        return None
+
+
+def stored_recipe(path: Path | str) -> str | None:
+    """The ``recipe_sha256`` an artefact records, or None (missing, unreadable, or from an older artic)."""
+    path = Path(path)
+    if not path.is_file():
+        return None
+    try:
+        if _is_h5(path):
+            with h5py.File(path, "r") as f:
+                if f.attrs.get("schema_version") != SCHEMA_VERSION or "content_sha256" not in f.attrs:
+                    return None
+                v = f.attrs.get("recipe_sha256")
+                return None if v is None else str(v)
+        doc = _read_doc(path)
+        return (doc.get("provenance") or {}).get("recipe_sha256") if isinstance(doc, dict) else None
+    except Exception:  # noqa: BLE001
+        return None
+
+
+def _same_h5(old: Path, new: Path) -> bool:
+    return stored_content_hash(old) == stored_content_hash(new) is not None
+
+
 @contextlib.contextmanager
-def atomic_h5(path: Path | str, kind: str, cfg_hash: str = "") -> Iterator[h5py.File]:
-    """Open a temporary HDF5 file that replaces ``path`` only on success."""
-    with atomic_path(path) as tmp:
+def atomic_h5(path: Path | str, kind: str, provenance: Provenance | None = None) -> Iterator[h5py.File]:
+    """Open a temporary HDF5 file that replaces ``path`` only on success, with its content hash and
+    provenance at the root."""
+    with atomic_path(path, same_content=_same_h5) as tmp:
         with h5py.File(tmp, "w") as f:
-            f.attrs.update({"kind": kind, "schema_version": SCHEMA_VERSION, "package_version": __version__,
-                            "config_hash": cfg_hash,
-                            "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")})
+            f.attrs.update({"kind": kind, "schema_version": SCHEMA_VERSION})
+            if provenance is not None:
+                f.attrs.update(provenance.attrs())
             yield f
+            f.attrs["content_sha256"] = h5_content_hash(f)
+
+
+def content_hash_of(path: Path | str, kind: str, hint: str) -> str:
+    """The content hash an artefact of ``kind`` records; an ArticError naming the fix if it has none."""
+    with open_artifact(path, kind, hint) as f:
+        v = f.attrs.get("content_sha256")
+    if v is None:
+        raise ArticError(f"{path} records no content hash; {hint}")
+    return str(v)
 
 
 def open_artifact(path: Path | str, kind: str, hint: str) -> h5py.File:
@@ -96,13 +185,11 @@ def _dataset(group: h5py.Group, name: str, data, units: str | None = None) -> No
 MESH_HINT = "rebuild it with 'artic build-mesh'"
 
 
-def save_mesh(path: Path | str, mesh: Mesh, wall: WallSurface, cfg: Config) -> None:
-    import yaml
-
-    h = config_hash(cfg)
-    with atomic_h5(path, "mesh", h) as f:
-        f.attrs["config_yaml"] = yaml.safe_dump(cfg.model_dump(mode="json"), sort_keys=False)
-        f.attrs["geometry_hash"] = geometry_hash(cfg)
+def save_mesh(path: Path | str, mesh: Mesh, wall: WallSurface, speaker: Speaker,
+              provenance: Provenance | None = None) -> None:
+    """The mesh and wall with the ``speaker`` section they were built from (nothing else of the config)."""
+    with atomic_h5(path, "mesh", provenance) as f:
+        f.attrs["speaker_json"] = json.dumps(speaker.model_dump(mode="json"), sort_keys=True)
         t = f.create_group("tongue")
         _dataset(t, "nodes", mesh.nodes, "cm")
         _dataset(t, "bricks", mesh.bricks)
@@ -123,13 +210,19 @@ def save_mesh(path: Path | str, mesh: Mesh, wall: WallSurface, cfg: Config) -> N
         w.attrs["normals"] = "unit, pointing out of the lumen (into the wall)"
 
 
-def load_mesh(path: Path | str, expect: Config | None = None) -> tuple[Mesh, WallSurface, Config]:
-    """Mesh, wall and the config that built them; checks the config matches ``expect``."""
+@dataclass
+class MeshFile:
+    mesh: Mesh
+    wall: WallSurface
+    speaker: Speaker
+    content_sha256: str
+
+
+def load_mesh(path: Path | str, expect: Speaker | None = None) -> MeshFile:
+    """Mesh, wall and the speaker section that built them; checks the speaker matches ``expect``."""
     with open_artifact(path, "mesh", MESH_HINT) as f:
         try:
-            import yaml
-
-            cfg = parse_config(yaml.safe_load(f.attrs["config_yaml"]), f"{path} (embedded config)")
+            speaker = parse_speaker(json.loads(f.attrs["speaker_json"]), f"{path} (embedded speaker)")
             t, w = f["tongue"], f["wall"]
             mesh = Mesh(nodes=t["nodes"][()], bricks=t["bricks"][()], cylinders=t["cylinders"][()],
                         share=t["share"][()], areas=t["areas"][()],
@@ -137,13 +230,13 @@ def load_mesh(path: Path | str, expect: Config | None = None) -> tuple[Mesh, Wal
                         grid=tuple(int(g) for g in t.attrs["grid"]))
             wall = WallSurface(vertices=w["vertices"][()], triangles=w["triangles"][()],
                                normals=w["normals"][()], part=w["part"][()])
-            stored_hash = f.attrs["geometry_hash"]
+            content = str(f.attrs["content_sha256"])
         except (KeyError, OSError, ValueError, TypeError):
             raise ArticError(f"{path} is missing mesh data (truncated or from another tool); {MESH_HINT}") from None
-    if expect is not None and stored_hash != geometry_hash(expect):
-        raise ArticError(f"{path} was built from another speaker geometry (hash {stored_hash[:12]}, "
-                         f"config {geometry_hash(expect)[:12]}); {MESH_HINT} --config <your config>")
-    return mesh, wall, cfg
+    if expect is not None and digest(expect.model_dump(mode="json")) != digest(speaker.model_dump(mode="json")):
+        raise ArticError(f"{path} was built from another speaker geometry than the config's; "
+                         f"{MESH_HINT} --config <your config>")
+    return MeshFile(mesh, wall, speaker, content)
 
 
 def file_hash(path: Path | str) -> str:
@@ -157,8 +250,51 @@ def file_hash(path: Path | str) -> str:
 
 
 def write_text_atomic(path: Path | str, text: str) -> Path:
-    """Write a text artefact through a temporary file and a rename."""
+    """Write a text file (a figure index, a CSV) through a temporary file and a rename."""
     path = Path(path)
     with atomic_path(path) as tmp:
         tmp.write_text(text)
     return path
+
+
+def _read_doc(path: Path):
+    import yaml
+
+    text = Path(path).read_text()
+    return json.loads(text) if Path(path).suffix == ".json" else yaml.safe_load(text)
+
+
+def doc_content_hash(doc: dict) -> str:
+    return digest({k: v for k, v in doc.items() if k != "provenance"})
+
+
+def write_doc(path: Path | str, doc: dict, provenance: Provenance | None = None) -> Path:
+    """A JSON (``.json``) or YAML artefact, its ``provenance`` (with the content hash) under that key; a
+    rewrite with the same content keeps the old file's mtime."""
+    import yaml
+
+    path = Path(path)
+    body = {k: v for k, v in doc.items() if k != "provenance"}
+    prov = dict(provenance.attrs()) if provenance is not None else {}
+    prov["content_sha256"] = doc_content_hash(body)
+    body["provenance"] = prov
+    text = (json.dumps(body, indent=1, default=float) if path.suffix == ".json"
+            else yaml.safe_dump(body, sort_keys=False))
+    with atomic_path(path, same_content=lambda old, new: stored_content_hash(old) == prov["content_sha256"]) as tmp:
+        tmp.write_text(text)
+    return path
+
+
+def read_doc(path: Path | str, what: str, hint: str) -> dict:
+    """A JSON/YAML artefact written by :func:`write_doc`; one ArticError naming the fix if it is not one."""
+    path = Path(path)
+    if not path.is_file():
+        raise ArticError(f"{what} not found: {path}; {hint}")
+    try:
+        doc = _read_doc(path)
+    except Exception:  # noqa: BLE001 - any parse failure is a damaged file
+        raise ArticError(f"{path} is not a readable {what} (damaged or truncated); {hint}") from None
+    if not isinstance(doc, dict) or "provenance" not in doc:
+        raise ArticError(f"{path} is not a {what} written by this artic; {hint}")
+    return doc
+

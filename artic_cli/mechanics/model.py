@@ -35,6 +35,9 @@ from .isotropy import isotropic_areas
 from .muscles import MuscleSet, muscle_set
 
 
+
+CONTROL_POINTS = ("tip", "dorsum", "jaw")  # the names of the EMA-style control points, in this order
+
 @dataclass(frozen=True)
 class SolverOptions:
     dt: float = 5e-3  # s
@@ -146,6 +149,11 @@ class Model:
     def drivable(self) -> list[str]:
         """Every name a schedule may drive: muscles and groups."""
         return [*self.muscle_names, *self.groups]
+
+    def control_points(self) -> dict[str, int]:
+        """The EMA-style control points this model has: tongue tip, dorsum (fifth midsagittal surface node
+        from the tip) and jaw (lower incisor), each a node index."""
+        return {name: int(self.node_sets[name][0]) for name in CONTROL_POINTS if name in self.node_sets}
 
 
 @dataclass
@@ -327,6 +335,10 @@ def _concat(a: CylinderSet, b: CylinderSet) -> CylinderSet:
     return CylinderSet(**{f: np.concatenate([getattr(a, f), getattr(b, f)]) for f in
                           ("i", "j", "l0", "area0", "youngs", "viscosity", "poisson", "knee", "rate")},
                        n_nodes=a.n_nodes)
+
+
+# the config sections building the articulator reads (build_articulator is handed a view of just these)
+ARTICULATOR_SECTIONS = ("speaker", "materials", "simulation", "muscles", "jaw", "contact")
 
 
 def build_articulator(cfg: Config, mesh: Mesh, wall: WallSurface | None = None, *,

@@ -18,11 +18,13 @@ import csv
 import io
 import os
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 
 from ..errors import ArticError
-from .store import atomic_path, load_mesh, open_artifact, write_text_atomic
+from ..io.store import atomic_path, load_mesh, write_text_atomic
+from .simulate import read as read_simulation
 
 SIM_HINT = "rerun 'artic simulate' to produce it"
 
@@ -42,7 +44,8 @@ def _write(path: Path, mesh) -> None:
 
 def export_mesh_vtk(mesh_path: Path | str, out_dir: Path | str) -> list[Path]:
     meshio = _meshio()
-    mesh, wall, _ = load_mesh(mesh_path)
+    m = load_mesh(mesh_path)
+    mesh, wall = m.mesh, m.wall
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     tongue = meshio.Mesh(mesh.nodes, [("hexahedron", mesh.bricks)],
@@ -55,22 +58,16 @@ def export_mesh_vtk(mesh_path: Path | str, out_dir: Path | str) -> list[Path]:
 
 
 def _read_sim(sim_path: Path | str):
-    with open_artifact(sim_path, "simulation", SIM_HINT) as f:
-        try:
-            x = f["nodes/positions"][()]
-            v = f["nodes/velocities"][()]
-            t = f["time"][()]
-            cps = {k: f[f"control_points/{k}/position"][()] for k in f["control_points"]}
-            return t, x, v, cps
-        except KeyError as err:
-            raise ArticError(f"{sim_path} lacks {err}; {SIM_HINT}") from None
+    s = read_simulation(sim_path)
+    return s.time_s, s.positions_cm, s.velocities_cm_s, s.control_points
 
 
 def export_simulation_vtk(sim_path: Path | str, mesh_path: Path | str, out_dir: Path | str,
                           every: int = 1) -> list[Path]:
     """Frames as VTU + a PVD index, and an XDMF time series of displacements."""
     meshio = _meshio()
-    mesh, _, cfg = load_mesh(mesh_path)
+    m = load_mesh(mesh_path)
+    mesh = m.mesh
     t, x, v, _ = _read_sim(sim_path)
     nt = len(mesh.nodes)
     if x.shape[1] < nt:
@@ -79,7 +76,7 @@ def export_simulation_vtk(sim_path: Path | str, mesh_path: Path | str, out_dir: 
     if x.shape[1] > nt:  # the articulator: jaw and hyoid as lines between their nodes
         from ..geometry.anatomy import LINK_KINDS, build_body
 
-        body = build_body(cfg, mesh)
+        body = build_body(SimpleNamespace(speaker=m.speaker), mesh)
         bones = body.links[np.isin(body.link_kind, [LINK_KINDS.index(k) for k in ("mandible", "hyoid")])]
         cells.append(("line", bones))
     out = Path(out_dir)

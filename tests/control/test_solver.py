@@ -11,11 +11,12 @@ import numpy as np
 import pytest
 import yaml
 
-from artic_cli.control.dynamic import build_dynamic_map, derive, load_dynamic_map, table_iv
-from artic_cli.control.epmap import build_ep_maps
+from artic_cli.control.dynamic import derive, table_iv
+from artic_cli.stages.dynamic import build_dynamic_map, load_dynamic_map
+from artic_cli.stages.epmap import build_ep_maps
 from artic_cli.control.solver import parse_target
-from artic_cli.control.targets import load_context, read_batch, solve, solve_batch
-from artic_cli.control.verify import Simulator
+from artic_cli.control.targets import read_batch, solve, solve_batch
+from artic_cli.stages.solve import load_context, simulator
 from artic_cli.errors import ArticError, UnreachableTarget
 
 from conftest import ROOT
@@ -51,7 +52,7 @@ def _target(tip, dorsum=None, tol=0.05, jaw=None):
 def _round_trip(args):
     """Simulate a force set, hand its tip (crucial) and dorsum (indecisive) to the solver, verify."""
     k, mesh_file, cfg, tmp, forces = args
-    sim = Simulator(mesh_file, cfg)
+    sim = simulator(mesh_file, cfg)
     reached = sim.reach({"JO": 0.5}, forces)
     ctx = load_context(tmp / "maps.h5", tmp / "dynamic.h5")
     target = _target(reached[0, :2], reached[1, :2])
@@ -80,7 +81,7 @@ def test_round_trip_of_twenty_random_force_sets(maps, mesh_file):
 
 def test_refine_reaches_a_tight_tolerance_the_maps_alone_miss(maps, mesh_file):
     tmp, cfg = maps
-    sim = Simulator(mesh_file, cfg)
+    sim = simulator(mesh_file, cfg)
     ctx = load_context(tmp / "maps.h5", tmp / "dynamic.h5")
     for forces in ({"SL": 3.7, "GGp": 2.2}, {"GGm": 2.0, "SG": 0.6}, {"SL": 1.3, "GGa": 3.5}):
         reached = sim.reach({"JO": 0.5}, forces)
@@ -173,15 +174,14 @@ def test_bad_target_files_fail_in_one_line(case, maps, tmp_path):
     assert not (tmp_path / "s.yaml").exists()
 
 
-def test_unreachable_exits_3_and_maps_from_another_mesh_exit_2(maps, tmp_path, mesh_file):
+def test_unreachable_exits_3_and_maps_from_another_mesh_exit_2(maps, tmp_path, mesh_file, other_mesh_file):
     tmp, _ = maps
     f = tmp_path / "t.yaml"
     f.write_text("crucial: {point: tip, at_cm: [3, 3]}\n")
     res = artic("solve-target", f, "--maps", tmp / "maps.h5", "--dynamic", tmp / "dynamic.h5", "--out",
                 tmp_path / "s.yaml")
     assert res.returncode == 3 and "nearest reachable point" in res.stderr and "Traceback" not in res.stderr
-    other = tmp_path / "other.h5"
-    other.write_bytes(mesh_file.read_bytes() + b"\0")
+    other = other_mesh_file
     res = artic("solve-target", f, "--maps", tmp / "maps.h5", "--dynamic", tmp / "dynamic.h5", "--verify",
                 "--mesh", other)
     assert res.returncode == 2 and "another mesh" in res.stderr

@@ -43,8 +43,8 @@ def test_build_mesh_writes_provenance_and_a_figure(tmp_path):
     assert res.returncode == 0, res.stderr
     assert "231 nodes, 120 bricks" in res.stdout
     with h5py.File(out) as f:
-        assert f.attrs["kind"] == "mesh" and f.attrs["schema_version"] == 1
-        assert len(f.attrs["config_hash"]) == 64 and f.attrs["package_version"]
+        assert f.attrs["kind"] == "mesh" and f.attrs["schema_version"] == 2
+        assert len(f.attrs["content_sha256"]) == 64 and f.attrs["package_version"]
         assert f["tongue/nodes"].attrs["units"] == "cm"
         assert f["tongue/nodes"].shape == (231, 3)
     assert png.stat().st_size > 20_000
@@ -67,7 +67,8 @@ def test_simulate_writes_trajectories_volume_and_metadata(mesh_file, schedule, t
     assert "max |volume change|" in res.stdout
     with h5py.File(out) as f:
         assert f.attrs["kind"] == "simulation"
-        assert len(f.attrs["mesh_sha256"]) == 64 and len(f.attrs["schedule_sha256"]) == 64
+        inputs = json.loads(f.attrs["inputs_json"])
+        assert len(inputs["mesh"]) == 64 and len(inputs["schedule"]) == 64 and len(f.attrs["recipe_sha256"]) == 64
         assert f.attrs["dt_s"] == pytest.approx(0.005) and f.attrs["scheme"] == "houbolt"
         x = f["nodes/positions"][()]
         assert x.shape == (13, 231, 3)

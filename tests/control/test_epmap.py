@@ -10,7 +10,8 @@ import pytest
 import yaml
 
 from artic_cli.config import load_config
-from artic_cli.control.epmap import build_ep_maps, load_ep_maps, monotonic_exceptions, plan
+from artic_cli.control.epmap import monotonic_exceptions, plan
+from artic_cli.stages.epmap import build_ep_maps, load_ep_maps
 from artic_cli.errors import ArticError
 from artic_cli.experiments.paper import fig7
 
@@ -106,8 +107,8 @@ def test_map_file_is_plain_hdf5_with_units_and_provenance(small, cfg):
     tmp, _, first = small
     assert first.computed == first.total and first.cached == 0
     with h5py.File(tmp / "maps.h5", "r") as f:
-        assert f.attrs["kind"] == "epmap" and len(f.attrs["mesh_sha256"]) == 64
-        assert len(f.attrs["config_hash"]) == 64 and f.attrs["package_version"]
+        assert f.attrs["kind"] == "epmap" and len(json.loads(f.attrs["inputs_json"])["mesh"]) == 64
+        assert len(f.attrs["content_sha256"]) == 64 and f.attrs["package_version"]
         g = f["jaw_positions/rest/single/SG"]
         assert list(g["force_0_n"][()]) == [0.0, 1.0, 4.0] and g["force_0_n"].attrs["units"] == "N"
         assert g["tip"].shape == (3, 3) and g["tip"].attrs["units"] == "cm"
@@ -171,7 +172,7 @@ def test_bad_specs_are_named(tmp_path, mesh_file):
         build_ep_maps(mesh_file, cfg, tmp_path / "m.h5")
 
 
-def test_unreachable_scheduler_and_damaged_maps_fail_cleanly(small, mesh_file, tmp_path):
+def test_unreachable_scheduler_and_damaged_maps_fail_cleanly(small, mesh_file, other_mesh_file, tmp_path):
     tmp, cfg, _ = small
     with pytest.raises(ArticError, match="cannot reach the dask scheduler"):
         build_ep_maps(mesh_file, cfg, tmp_path / "m.h5", backend="dask", scheduler="tcp://127.0.0.1:9",
@@ -181,10 +182,8 @@ def test_unreachable_scheduler_and_damaged_maps_fail_cleanly(small, mesh_file, t
     bad.write_bytes((tmp / "maps.h5").read_bytes()[:4000])
     with pytest.raises(ArticError, match="not a readable HDF5 file"):
         load_ep_maps(bad)
-    other = tmp_path / "other_mesh.h5"
-    other.write_bytes(b"not the mesh")
     with pytest.raises(ArticError, match="another mesh"):
-        load_ep_maps(tmp / "maps.h5", mesh=other)
+        load_ep_maps(tmp / "maps.h5", mesh=other_mesh_file)
 
 
 def test_existing_maps_survive_a_failed_build(small, mesh_file, tmp_path):

@@ -13,8 +13,8 @@ import pytest
 from conftest import ROOT
 
 VENV = ROOT / ".venv"
-pytestmark = pytest.mark.skipif(not (VENV / ".installed").exists() or shutil.which("make") is None,
-                                reason="needs `make setup` (the pipeline runs the installed artic)")
+pytestmark = [pytest.mark.slow, pytest.mark.skipif(not (VENV / ".installed").exists() or shutil.which("make") is None,
+                                reason="needs `make setup` (the pipeline runs the installed artic)")]
 
 
 def make(*args, timeout=1200):

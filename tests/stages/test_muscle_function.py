@@ -3,11 +3,15 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 import yaml
 
-from artic_cli.experiments.muscle_function import build_muscle_function, convergence, load_muscle_function
+from artic_cli.experiments.muscle_function import convergence
+from artic_cli.stages.muscle_function import build_muscle_function, load_muscle_function
 
 from conftest import ROOT
+
+pytestmark = pytest.mark.slow
 
 
 def test_starts_scatter_and_each_muscle_gathers_them(tmp_path, mesh_file):
@@ -15,7 +19,7 @@ def test_starts_scatter_and_each_muscle_gathers_them(tmp_path, mesh_file):
     d["muscle_function"] = {"start_levels_n": [0.0, 3.0], "muscles": ["GGp", "SG"]}
     cfg = tmp_path / "mf.yaml"
     cfg.write_text(yaml.safe_dump(d))
-    mf, _, cached, distinct = build_muscle_function(mesh_file, cfg, tmp_path / "mf.h5", jobs=2,
+    mf, _, cached, distinct, _ = build_muscle_function(mesh_file, cfg, tmp_path / "mf.h5", jobs=2,
                                                     cache=tmp_path / "cache")
     assert len(mf.starts) == 4 * 2 ** 3 and cached == 0
     assert distinct == 18  # the four combinations share GGa (and GGp, GGm, HG, SG pairwise)

@@ -1,0 +1,116 @@
+"""One equilibrium position (EP): hold a set of muscle forces from a jaw position's rest and read where the
+tongue tip, the dorsum and the jaw come to rest (the paper's section IV.B).
+
+Pure physics over a model: no maps, no files.  The worker functions at the bottom build the model once per
+process (they travel to loky or dask workers) and are what the EP-map sweep caches.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import units
+from ..config import ConfigView, EPMapSpec, parse_config
+from ..geometry.mesh import Mesh
+from ..geometry.wall import WallSurface
+from ..mechanics.loads import muscle_force_vector
+from ..mechanics.model import ARTICULATOR_SECTIONS, Control, Model, State, build_articulator
+from ..mechanics.simulate import equilibrate, hold, settle
+
+Forces = tuple[tuple[str, float], ...]
+
+
+def canonical(forces: dict[str, float]) -> Forces:
+    """A hashable, order-free form of a force set; zero forces dropped."""
+    return tuple(sorted((str(k), float(v)) for k, v in forces.items() if float(v) > 0.0))
+
+
+def add_forces(*parts: dict[str, float]) -> dict[str, float]:
+    out: dict[str, float] = {}
+    for p in parts:
+        for k, v in p.items():
+            out[k] = out.get(k, 0.0) + v
+    return out
+
+
+@dataclass
+class EP:
+    x: np.ndarray  # (3, 3): tip, dorsum, jaw (cm)
+    drift_cm: float  # largest control-point move over the last window
+    converged: bool
+    stopped_ms: float
+
+
+
+def control_for(model: Model, forces_n: dict[str, float]) -> Control:
+    return Control(node_force=np.zeros((model.n_nodes, 3)), muscle_force=muscle_force_vector(model, forces_n))
+
+
+def watch_nodes(model: Model) -> np.ndarray:
+    return np.array(list(model.control_points().values()))
+
+
+def jaw_rest(model: Model, jaw_forces: dict[str, float]) -> State:
+    """The rest posture of a jaw position: equilibrium with the jaw forces held (t = 0)."""
+    rest = settle(model)
+    if not canonical(jaw_forces):
+        return rest
+    state, _ = equilibrate(model, rest, control_for(model, jaw_forces), dt=0.01, tol=1e-2)
+    return State(t=0.0, x=state.x, v=np.zeros_like(state.v), sigma2=state.sigma2, fibre_strain=state.fibre_strain)
+
+
+def equilibrium_point(model: Model, start: State, forces_n: dict[str, float], spec: EPMapSpec,
+                      fast: bool = False) -> EP:
+    """Hold the forces for ``spec.duration_ms`` (``fast``: stop once settled) and read the control points."""
+    h = hold(model, start, control_for(model, forces_n), units.ms_to_s(spec.duration_ms), watch_nodes(model),
+             units.ms_to_s(spec.convergence_window_ms), stop_below=spec.early_stop_tol_cm if fast else None)
+    return EP(x=h.state.x[watch_nodes(model)].copy(), drift_cm=h.drift,
+              converged=bool(h.drift < spec.convergence_tol_cm), stopped_ms=units.s_to_ms(h.stopped))
+
+
+# --- workers (top level: they travel to loky / dask processes) --------------------------------------
+
+_MODELS: dict[str, Model] = {}
+_RESTS: dict[tuple, State] = {}
+
+
+def worker_model(key: str, cfg_json: str, mesh: Mesh, wall: WallSurface) -> Model:
+    """The articulator for ``key`` (the hash of its config sections, mesh content and code), built once per
+    process."""
+    if key not in _MODELS:
+        cfg = ConfigView(parse_config(json.loads(cfg_json), "<worker config>"), ARTICULATOR_SECTIONS)
+        _MODELS.clear()
+        _MODELS[key] = build_articulator(cfg, mesh, wall)
+    return _MODELS[key]
+
+
+def worker_rest(key: str, jaw_forces: Forces, cfg_json: str, mesh: Mesh, wall: WallSurface) -> State:
+    if (key, jaw_forces) not in _RESTS:
+        _RESTS[(key, jaw_forces)] = jaw_rest(worker_model(key, cfg_json, mesh, wall), dict(jaw_forces))
+    return _RESTS[(key, jaw_forces)]
+
+
+def compute_ep(key: str, jaw_forces: Forces, forces: Forces, spec_json: str, fast: bool, cfg_json: str,
+               mesh: Mesh, wall: WallSurface) -> dict:
+    """One EP as plain arrays (cached on everything but the last three arguments: ``key`` stands for them)."""
+    model = worker_model(key, cfg_json, mesh, wall)
+    spec = EPMapSpec.model_validate(json.loads(spec_json))
+    start = worker_rest(key, jaw_forces, cfg_json, mesh, wall)
+    ep = equilibrium_point(model, start, add_forces(dict(jaw_forces), dict(forces)), spec, fast)
+    return {"x": ep.x, "drift_cm": ep.drift_cm, "converged": ep.converged, "stopped_ms": ep.stopped_ms}
+
+
+def compute_rest(key: str, jaw_forces: Forces, cfg_json: str, mesh: Mesh, wall: WallSurface) -> dict:
+    model = worker_model(key, cfg_json, mesh, wall)
+    st = worker_rest(key, jaw_forces, cfg_json, mesh, wall)
+    return {"x": st.x[watch_nodes(model)].copy(), "mandible": st.x[model.node_sets["mandible"]].copy()}
+
+
+def spec_key(spec: EPMapSpec) -> str:
+    """The parts of the spec an EP depends on (not the lists of what to compute)."""
+    keep = {k: getattr(spec, k) for k in ("duration_ms", "convergence_window_ms", "convergence_tol_cm",
+                                          "early_stop_tol_cm")}
+    return json.dumps(keep, sort_keys=True)

@@ -1,0 +1,103 @@
+"""One cached parallel sweep for every family of independent runs (EP maps, muscle function, batches).
+
+Calls run through joblib (loky on this machine, dask.distributed on a cluster); with a cache folder each
+result is kept on disk by ``joblib.Memory`` under the hash of its arguments, so an interrupted sweep resumes
+and a repeated one computes nothing.  Arguments named in ``ignore`` travel to the worker but are not part of
+the key: the caller puts what they depend on (content hashes) into the key arguments.
+"""
+
+from __future__ import annotations
+
+import contextlib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable, Iterator, Sequence
+
+from .errors import ArticError
+
+
+@contextlib.contextmanager
+def parallel_backend(backend: str, jobs: int, scheduler: str | None) -> Iterator[None]:
+    """joblib's backend for a sweep: loky processes here, or a dask.distributed cluster (a local one over
+    loopback without ``scheduler``)."""
+    from joblib import parallel_config
+
+    if jobs < 1:
+        raise ArticError(f"--jobs must be at least 1, got {jobs}")
+    if backend == "loky":
+        if scheduler:
+            raise ArticError("--scheduler needs --backend dask")
+        with parallel_config(backend="loky", n_jobs=jobs):
+            yield
+        return
+    if backend != "dask":
+        raise ArticError(f"unknown --backend '{backend}'; valid: loky, dask")
+    try:
+        from dask.distributed import Client, LocalCluster
+    except ImportError:  # pragma: no cover - distributed is a dependency
+        raise ArticError("--backend dask needs dask.distributed; pip install distributed") from None
+    cluster = None
+    try:
+        if scheduler:
+            client = Client(scheduler, timeout="10s")
+        else:
+            cluster = LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                   dashboard_address=None)
+            client = Client(cluster)
+    except (OSError, TimeoutError) as err:
+        raise ArticError(f"cannot reach the dask scheduler at {scheduler}: {type(err).__name__}; start one "
+                         "('dask scheduler') or use --backend loky") from None
+    try:
+        with parallel_config(backend="dask", n_jobs=-1):
+            yield
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """How to run a sweep: workers, backend, and where finished results are kept (None: not kept)."""
+
+    jobs: int = 1
+    backend: str = "loky"
+    scheduler: str | None = None
+    cache: Path | str | None = None
+    progress: Callable[[int, int], None] | None = None
+
+
+@dataclass
+class SweepResult:
+    results: list
+    cached: int
+
+
+def _indexed(i: int, fn, args: tuple):
+    return i, fn(*args)
+
+
+def run_sweep(fn: Callable, calls: Sequence[tuple], sweep: Sweep, ignore: Sequence[str] = (),
+              phases: Sequence[Sequence[int]] | None = None) -> SweepResult:
+    """``[fn(*args) for args in calls]`` in parallel, cached; ``phases`` run one after another (e.g. the rest
+    postures before the runs that start from them)."""
+    from joblib import Memory, Parallel, delayed
+
+    if sweep.cache is not None:
+        fn = Memory(Path(sweep.cache), verbose=0).cache(fn, ignore=list(ignore))
+        cached = sum(bool(fn.check_call_in_cache(*a)) for a in calls)
+    else:
+        cached = 0
+    results: list = [None] * len(calls)
+    done = 0
+    if sweep.progress is not None:
+        sweep.progress(0, len(calls))
+    with parallel_backend(sweep.backend, sweep.jobs, sweep.scheduler):
+        for phase in (phases or [range(len(calls))]):
+            gen = Parallel(return_as="generator_unordered")(delayed(_indexed)(i, fn, calls[i]) for i in phase)
+            for i, res in gen:
+                results[i] = res
+                done += 1
+                if sweep.progress is not None:
+                    sweep.progress(done, len(calls))
+    return SweepResult(results, cached)

@@ -1,0 +1,223 @@
+"""Stage ``simulate``: move the model under a schedule of muscle forces and loads; the trajectories on disk.
+
+``run_simulation`` takes objects (a model, a schedule) and returns a :class:`Trajectory`; ``write`` and
+``read`` are the file.  ``simulate`` is the file-level entry the CLI and ``make`` call.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from .. import units
+from ..config import Config, load_config
+from ..errors import ArticError
+from ..geometry.wall import WallSurface
+from ..io.fingerprint import digest, sections_hash
+from ..io.store import Provenance, atomic_h5, open_artifact
+from ..mechanics.loads import load_program
+from ..mechanics.model import ARTICULATOR_SECTIONS, Model, build_articulator, build_model, rest_state
+from ..mechanics.simulate import Trajectory, run, settle
+from ..schedule import Schedule, load_schedule
+from . import mesh as mesh_stage
+from .base import Stage, up_to_date
+
+STAGE = Stage(name="sims", module=__name__, sections=ARTICULATOR_SECTIONS, reads=("mesh",), kind="simulation",
+              hint="rerun 'artic simulate'")
+TONGUE_SECTIONS = ("materials", "simulation")
+
+
+def build(cfg: Config, mesh, wall: WallSurface, tongue_only: bool = False, volume_constraint: bool | None = None,
+          contact: bool | None = None) -> Model:
+    """The whole articulator, or the tongue alone with its fixed node sets held."""
+    view = STAGE.view(cfg)
+    if tongue_only:
+        return build_model(mesh, view.materials.tongue, view.simulation, volume_constraint=volume_constraint)
+    return build_articulator(view, mesh, wall, volume_constraint=volume_constraint, contact=contact)
+
+
+def load_model(mesh_path: Path | str, config: Path | str | None = None, volume_constraint: bool | None = None,
+               tongue_only: bool = False, contact: bool | None = None) -> tuple[Model, Config, WallSurface]:
+    """The model of a mesh file and a config (the mesh checked against the config's speaker)."""
+    cfg = load_config(config)
+    m = mesh_stage.read(mesh_path, cfg)
+    return build(cfg, m.mesh, m.wall, tongue_only, volume_constraint, contact), cfg, m.wall
+
+
+def run_simulation(model: Model, schedule: Schedule, duration_s: float, dt_s: float, tongue_only: bool = False,
+                   record_every: int = 1, source: str = "schedule",
+                   progress: Callable[[int, int], None] | None = None) -> Trajectory:
+    """From the rest posture (settled under gravity for the articulator), under ``schedule``."""
+    program = load_program(model, schedule, source)
+    start = rest_state(model) if tongue_only else settle(model)
+    traj, _ = run(model, start, program.control_at, duration_s, dt_s, record_every=record_every,
+                  progress=progress)
+    return traj
+
+
+def _positive(name: str, value: float | None) -> None:
+    if value is not None and (not math.isfinite(value) or value <= 0):
+        raise ArticError(f"{name} must be a positive number of seconds, got {value}")
+
+
+@dataclass
+class SimResult:
+    path: Path
+    trajectory: Trajectory | None  # None when the file was already up to date
+    model: Model
+    wall: WallSurface
+    max_volume_change: float
+    up_to_date: bool = False
+
+
+def simulate(schedule: Path | str, duration: float | None = None, dt: float | None = None,
+             mesh: Path | str = "data/mesh.h5", config: Path | str | None = None, out: Path | str | None = None,
+             volume_constraint: bool | None = None, progress: Callable[[int, int], None] | None = None,
+             tongue_only: bool = False, contact: bool | None = None, force: bool = False) -> SimResult:
+    """Run the model under a schedule from its rest posture; write ``out`` (HDF5).  A file that already holds
+    this recipe (same mesh content, config sections, schedule, options and code) is left alone."""
+    _positive("--duration", duration)
+    _positive("--dt", dt)
+    sched = load_schedule(schedule)
+    if duration is None:
+        if sched.duration_ms is None:
+            raise ArticError(f"{schedule}: no duration; give --duration S or 'duration_ms' in the schedule")
+        duration = units.ms_to_s(sched.duration_ms)
+    sched.check_duration(units.s_to_ms(duration), str(schedule))
+    cfg = load_config(config)
+    m = mesh_stage.read(mesh, cfg)
+    model = build(cfg, m.mesh, m.wall, tongue_only, volume_constraint, contact)
+    h = model.options.dt if dt is None else dt
+    if h > duration:
+        raise ArticError(f"--dt {h:g} s is longer than the run ({duration:g} s); give a smaller --dt")
+    out = Path(out) if out is not None else Path("data/sims") / f"{Path(schedule).stem}.h5"
+    sections = TONGUE_SECTIONS if tongue_only else ARTICULATOR_SECTIONS
+    prov = Provenance(stage=STAGE.name, sections_sha256=sections_hash(cfg, sections),
+                      inputs={"mesh": m.content_sha256, "schedule": digest(sched.model_dump(mode="json"))},
+                      code_sha256=STAGE.provenance(None).code_sha256,
+                      params={"duration_s": duration, "dt_s": h, "tongue_only": tongue_only,
+                              "volume_constraint": model.volume_constraint, "contact": model.contact is not None,
+                              "record_every": cfg.simulation.record_every})
+    if not force and up_to_date(out, prov):
+        with open_artifact(out, "simulation", STAGE.hint) as f:
+            vol = float(f.attrs["max_abs_volume_change"])
+        return SimResult(out, None, model, m.wall, vol, up_to_date=True)
+    traj = run_simulation(model, sched, duration, h, tongue_only, cfg.simulation.record_every, str(schedule),
+                          progress)
+    write(out, traj, model, prov, extra={"duration_s": duration, "schedule_yaml": Path(schedule).read_text(),
+                                         "tongue_only": tongue_only})
+    return SimResult(out, traj, model, m.wall, float(np.abs(traj.volume_change).max()))
+
+
+def write(path: Path | str, traj: Trajectory, model: Model, prov: Provenance | None = None,
+          extra: dict | None = None) -> None:
+    """Times, node positions and velocities (and which nodes are tongue, mandible, hyoid), control points,
+    volume, energy, muscle forces and lengths, contacts; every dataset with its unit."""
+    with atomic_h5(path, "simulation", prov) as f:
+        f.attrs.update(extra or {})
+        opt = model.options
+        f.attrs.update({"dt_s": traj.stats["dt"], "scheme": opt.scheme, "newton_tol_cm": opt.tol,
+                        "newton_max_iter": opt.max_iter, "refactor_rate": opt.refactor_rate,
+                        "volume_constraint": model.volume_constraint, "wall_time_s": traj.stats["wall_time_s"],
+                        "steps": traj.stats["steps"], "factorisations": traj.stats["refactors"],
+                        "newton_iterations": traj.stats["newton_iterations"],
+                        "max_abs_volume_change": float(np.abs(traj.volume_change).max())})
+        f.create_dataset("time", data=traj.time).attrs["units"] = "s"
+        for name, data, unit in [("positions", traj.x, "cm"), ("velocities", traj.v, "cm/s")]:
+            f.create_dataset(f"nodes/{name}", data=data, compression="gzip").attrs["units"] = unit
+        for part, idx in node_parts(model).items():
+            f.create_dataset(f"nodes/parts/{part}", data=idx).attrs["units"] = "node indices"
+        for name, idx in model.control_points().items():
+            g = f.create_group(f"control_points/{name}")
+            g.attrs["node"] = idx
+            g.create_dataset("position", data=traj.x[:, idx]).attrs["units"] = "cm"
+            g.create_dataset("velocity", data=traj.v[:, idx]).attrs["units"] = "cm/s"
+        f.create_dataset("volume", data=traj.volume).attrs["units"] = "cm^3"
+        f.create_dataset("volume_change", data=traj.volume_change).attrs["units"] = "fraction of initial volume"
+        f.create_dataset("energy", data=units.erg_to_joule(traj.energy)).attrs["units"] = "J (kinetic + stored, from t0)"
+        f.create_dataset("work", data=units.erg_to_joule(traj.work)).attrs["units"] = "J (external loads + gravity)"
+        f.create_dataset("inverted_bricks", data=traj.inverted)
+        f.create_dataset("newton_iterations", data=traj.iterations)
+        if traj.muscle_force is not None:
+            g = f.create_group("muscles")
+            g.attrs["names"] = list(model.muscle_names)
+            g.create_dataset("force", data=units.dyn_to_newton(traj.muscle_force)).attrs["units"] = "N"
+            g.create_dataset("length", data=traj.muscle_length).attrs["units"] = "cm"
+        if traj.contact_count is not None:
+            g = f.create_group("contacts")
+            g.create_dataset("count", data=traj.contact_count)
+            g.create_dataset("total_force", data=units.dyn_to_newton(traj.contact_total)).attrs["units"] = "N"
+            g.create_dataset("projected", data=traj.projected)
+            g.create_dataset("offsets", data=np.cumsum([0] + [len(c) for c in traj.contact_nodes]))
+            g.create_dataset("nodes", data=np.concatenate(traj.contact_nodes).astype(np.int64))
+            g.create_dataset("force", data=units.dyn_to_newton(np.concatenate(traj.contact_forces))).attrs["units"] = "N"
+            g.attrs["layout"] = "frame k: nodes[offsets[k]:offsets[k+1]] with force[...] (N)"
+
+
+def node_parts(model: Model) -> dict[str, np.ndarray]:
+    """Which nodes are the tongue, the mandible and the hyoid (the rest are fixed or carried points)."""
+    parts = {"tongue": np.arange(model.n_tongue)}
+    for name in ("mandible", "hyoid"):
+        if name in model.node_sets:
+            parts[name] = np.asarray(model.node_sets[name])
+    return parts
+
+
+@dataclass
+class Contacts:
+    count: np.ndarray  # (T,) tongue nodes on the wall
+    total_force_n: np.ndarray  # (T,) N
+    nodes: list  # per frame: node indices
+    force_n: list  # per frame: N per node
+
+
+@dataclass
+class Simulation:
+    """A simulation file, read back whole: times (s), positions (cm) of every node and by part, control
+    points, muscle forces (N) and lengths (cm), contacts, volume and the run's settings."""
+
+    time_s: np.ndarray
+    positions_cm: np.ndarray  # (T, N, 3)
+    velocities_cm_s: np.ndarray
+    parts: dict[str, np.ndarray]  # part -> node indices
+    control_points: dict[str, np.ndarray]  # name -> (T, 3) cm
+    volume_change: np.ndarray
+    inverted_bricks: np.ndarray
+    muscle_names: list[str]
+    muscle_force_n: np.ndarray | None
+    muscle_length_cm: np.ndarray | None
+    contacts: Contacts | None
+    attrs: dict
+
+    def part(self, name: str) -> np.ndarray:
+        """(T, n, 3) positions of one part (tongue, mandible, hyoid), cm."""
+        return self.positions_cm[:, self.parts[name]]
+
+
+def read(path: Path | str) -> Simulation:
+    with open_artifact(path, "simulation", STAGE.hint) as f:
+        try:
+            contacts = None
+            if "contacts" in f:
+                g = f["contacts"]
+                off = g["offsets"][()]
+                nodes, force = g["nodes"][()], g["force"][()]
+                contacts = Contacts(count=g["count"][()], total_force_n=g["total_force"][()],
+                                    nodes=[nodes[a:b] for a, b in zip(off[:-1], off[1:])],
+                                    force_n=[force[a:b] for a, b in zip(off[:-1], off[1:])])
+            m = f.get("muscles")
+            return Simulation(
+                time_s=f["time"][()], positions_cm=f["nodes/positions"][()], velocities_cm_s=f["nodes/velocities"][()],
+                parts={k: v[()] for k, v in f["nodes/parts"].items()},
+                control_points={k: g["position"][()] for k, g in f["control_points"].items()},
+                volume_change=f["volume_change"][()], inverted_bricks=f["inverted_bricks"][()],
+                muscle_names=[] if m is None else [str(n) for n in m.attrs["names"]],
+                muscle_force_n=None if m is None else m["force"][()],
+                muscle_length_cm=None if m is None else m["length"][()], contacts=contacts,
+                attrs={k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()})
+        except (KeyError, ValueError, OSError) as err:
+            raise ArticError(f"{path} is damaged or incomplete ({type(err).__name__}); {STAGE.hint}") from None

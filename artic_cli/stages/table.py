@@ -1,0 +1,112 @@
+"""The one stage table: every stage's module, command, inputs and outputs, its figures, and the report's
+sections.  ``python -m artic_cli.pipeline`` renders the Makefile's rules from it, so a new stage is one new
+module plus its entry here.
+
+Placeholders: ``{out}`` the data folder, ``{report}`` the report folder, ``{config}`` the config file,
+``{name}`` one item of the stage's ``items`` list (a schedule, an experiment, a target) from the pipeline
+definition (``pipelines/paper.yaml``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+
+@dataclass(frozen=True)
+class Figure:
+    path: str  # the picture (under {report})
+    command: str  # artic command that draws it from the artefacts (figures of one command are drawn in one go)
+    option: str  # how the command is given this figure's path
+    module: str  # the plot module
+    inputs: tuple[str, ...] = ()  # artefacts it is drawn from (besides the stage's output)
+    items: str = ""  # only for the items of this pipeline list (default: every item of the stage)
+
+
+@dataclass(frozen=True)
+class StageEntry:
+    name: str  # make target
+    module: str  # artic_cli.stages.<module>
+    output: str  # the artefact
+    command: str  # the artic command that makes it
+    inputs: tuple[str, ...] = ()  # other artefacts and user files it reads
+    items: str = ""  # pipeline list the stage runs once per item of
+    ok_status: tuple[int, ...] = (0,)  # exit statuses that still count as done (3: target unreachable, answer written)
+    figures: tuple[Figure, ...] = field(default_factory=tuple)
+
+
+MESH = "{out}/mesh.h5"
+MAPS = "{out}/epmaps.h5"
+DYN = "{out}/dynamic.h5"
+
+SIM_PLOT = "plot simulation {output} --mesh {mesh} --config {config}"
+MF_PLOT = "plot muscle-function {output}"
+
+STAGES: tuple[StageEntry, ...] = (
+    StageEntry("mesh", "artic_cli.stages.mesh", MESH, "build-mesh --config {config} --out {output}",
+               figures=(Figure("{report}/fig1_mesh.png", "plot mesh --mesh {output}", "--out {figure}",
+                               "artic_cli.plots.mesh"),)),
+    StageEntry("cuboid", "artic_cli.stages.cuboid", "{out}/cuboid.json",
+               "validate cuboid --config {config} --out {output}"),
+    StageEntry("sims-tissue", "artic_cli.stages.simulate", "{out}/sims/{name}.h5",
+               "simulate --tongue-only --schedule {schedule} --mesh {mesh} --config {config} --out {output}",
+               inputs=(MESH, "configs/schedules/{name}.yaml"), items="tissue_schedules",
+               figures=(Figure("{report}/sim_{name}.png", SIM_PLOT, "--out {figure}", "artic_cli.plots.simulation",
+                               (MESH,)),)),
+    StageEntry("sims-novol", "artic_cli.stages.simulate", "{out}/sims/{name}_novol.h5",
+               "simulate --tongue-only --schedule {schedule} --mesh {mesh} --config {config} --out {output} "
+               "--no-volume-constraint", inputs=(MESH, "configs/schedules/{name}.yaml"),
+               items="tissue_without_constraint"),
+    StageEntry("sims", "artic_cli.stages.simulate", "{out}/sims/{name}.h5",
+               "simulate --schedule {schedule} --mesh {mesh} --config {config} --out {output}",
+               inputs=(MESH, "configs/schedules/{name}.yaml"), items="articulator_schedules",
+               figures=(Figure("{report}/{name}.png", SIM_PLOT, "--out {figure}", "artic_cli.plots.simulation",
+                               (MESH,)),
+                        Figure("{report}/{name}.gif", SIM_PLOT, "--animate {figure}", "artic_cli.plots.animation",
+                               (MESH,), items="animated"))),
+    StageEntry("experiments", "artic_cli.stages.experiments", "{out}/experiments/{name}.json",
+               "experiment {name} --mesh {mesh} --config {config} --out {output}", inputs=(MESH,),
+               items="experiments",
+               figures=(Figure("{report}/fig7_trajectories.png", "plot experiment {output}", "--out {figure}",
+                               "artic_cli.plots.muscle_function", items="fig7"),)),
+    StageEntry("musclefunction", "artic_cli.stages.muscle_function", "{out}/muscle_function.h5",
+               "muscle-function --mesh {mesh} --config {config} --out {output} --jobs 2 --cache {out}/cache",
+               inputs=(MESH,),
+               figures=(Figure("{report}/fig5_muscle_function_tip.png", MF_PLOT, "--tip {figure}",
+                               "artic_cli.plots.muscle_function"),
+                        Figure("{report}/fig6_muscle_function_dorsum.png", MF_PLOT, "--dorsum {figure}",
+                               "artic_cli.plots.muscle_function"))),
+    StageEntry("epmaps", "artic_cli.stages.epmap", MAPS,
+               "ep-map --mesh {mesh} --config {config} --out {output} --jobs 2 --cache {out}/cache", inputs=(MESH,),
+               figures=(Figure("{report}/fig8_epmap.png", "plot ep-map --maps {output}", "--out {figure}",
+                               "artic_cli.plots.epmap"),)),
+    StageEntry("dynamic", "artic_cli.stages.dynamic", DYN, "dynamic-map --maps {maps} --out {output}",
+               inputs=(MAPS,),
+               figures=(Figure("{report}/fig9_dynamic_map.png", "plot dynamic-map --maps {maps} --dynamic {output} "
+                               "--jaw $(FIG9_JAW)", "--out {figure}", "artic_cli.plots.dynamic", (MAPS,)),)),
+    StageEntry("solve", "artic_cli.stages.solve", "{out}/solutions/{name}.yaml",
+               "solve-target {target} --maps {maps} --dynamic {dynamic} --mesh {mesh} --config {config} --verify "
+               "--refine --out {output}", inputs=(MAPS, DYN, MESH, "configs/targets/{name}.yaml"), items="targets",
+               ok_status=(0, 3),
+               figures=(Figure("{report}/fig12_{name}.png", "plot solution {output} --target {target} --maps {maps} "
+                               "--dynamic {dynamic}", "--out {figure}", "artic_cli.plots.solution",
+                               (MAPS, DYN, "configs/targets/{name}.yaml")),)),
+)
+
+
+@dataclass(frozen=True)
+class ReportSection:
+    key: str  # function in artic_cli.stages.report.SECTIONS
+    title: str
+    stages: tuple[str, ...]  # the stages whose artefacts and figures it shows
+
+
+REPORT: tuple[ReportSection, ...] = (
+    ReportSection("tissue", "The semicontinuum tongue (section II)", ("mesh", "cuboid", "sims-tissue", "sims-novol")),
+    ReportSection("articulator", "Muscles, jaw-hyoid complex and contact (section III)", ("sims", "experiments")),
+    ReportSection("function", "Muscle function and equilibrium positions (section IV.A)",
+                  ("musclefunction", "experiments")),
+    ReportSection("maps", "EP maps, dynamic maps and the target solver (sections IV.B and V)",
+                  ("epmaps", "dynamic", "solve")),
+)
+REPORT_MODULE = "artic_cli.stages.report"
+REPORT_OUTPUT = "{report}/paper.md"
