@@ -27,11 +27,13 @@ Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 NonNeg = Annotated[float, Field(ge=0, allow_inf_nan=False)]
 
 
-class _Strict(BaseModel):
+class Strict(BaseModel):
+    """A user-facing YAML record: unknown keys are errors, values frozen once validated."""
+
     model_config = ConfigDict(extra="forbid", frozen=True)
 
 
-class TongueGeometry(_Strict):
+class TongueGeometry(Strict):
     midsagittal_outline_cm: Outline
     gg_origin_cm: Point2
     half_width_cm: Positive = 1.0
@@ -44,14 +46,14 @@ class TongueGeometry(_Strict):
     inner_fraction: Annotated[float, Field(gt=0, lt=0.9)] = 0.2
 
 
-class WallSlice(_Strict):
+class WallSlice(Strict):
     z_cm: NonNeg
     palate: Outline
     pharynx: Outline
     mandible: Outline
 
 
-class WallGeometry(_Strict):
+class WallGeometry(Strict):
     lumen_reference_cm: Point2
     points_per_outline: Annotated[int, Field(ge=3, le=400)] = 24
     slices: Annotated[list[WallSlice], Field(min_length=2)]
@@ -65,14 +67,14 @@ class WallGeometry(_Strict):
         return v
 
 
-class Speaker(_Strict):
+class Speaker(Strict):
     name: str
     tongue: TongueGeometry
     wall: WallGeometry
     landmarks_cm: dict[str, Point3]
 
 
-class TissueMaterial(_Strict):
+class TissueMaterial(Strict):
     density_g_cm3: Positive = 1.0
     youngs_modulus_kpa: Positive = 20.0
     viscosity_kpa_s: NonNeg = 2.0
@@ -83,19 +85,19 @@ class TissueMaterial(_Strict):
     volume_constraint_gain: Annotated[float, Field(ge=1.0, le=1000.0)] = 1.0
 
 
-class BoneMaterial(_Strict):
+class BoneMaterial(Strict):
     youngs_modulus_kpa: Positive = 9.6e6
     viscosity_kpa_s: NonNeg = 9.6e5
     mandible_mass_g: Positive = 150.0
     hyoid_mass_g: Positive = 5.0
 
 
-class Materials(_Strict):
+class Materials(Strict):
     tongue: TissueMaterial
     bone: BoneMaterial = BoneMaterial()
 
 
-class Simulation(_Strict):
+class Simulation(Strict):
     dt_ms: Positive = 5.0
     scheme: Literal["houbolt", "bdf1"] = "houbolt"
     gravity_cm_s2: NonNeg = 980.0
@@ -107,7 +109,7 @@ class Simulation(_Strict):
     record_every: Annotated[int, Field(ge=1)] = 1
 
 
-class Muscles(_Strict):
+class Muscles(Strict):
     thickness_cm2: dict[str, Positive] = {
         "GGa": 1.0, "GGm": 1.5, "GGp": 2.0, "HG": 1.5, "SG": 1.5, "SL": 1.0, "IL": 1.0, "T": 1.0, "V": 1.0,
         "GH": 0.5, "MH": 1.0, "temporalis_anterior": 2.0, "temporalis_posterior": 1.5, "masseter": 2.5,
@@ -125,7 +127,7 @@ class Muscles(_Strict):
     postural_tone_n: dict[str, NonNeg] = {"JC": 2.1}
 
 
-class Jaw(_Strict):
+class Jaw(Strict):
     link_area_cm2: Positive = 0.1
     eminence_slope_deg: Annotated[float, Field(ge=-80, le=0)] = -30.0
     guide_stiffness_n_per_cm: Positive = 1000.0
@@ -137,7 +139,7 @@ class Jaw(_Strict):
     floor_link_area_cm2: Positive = 0.3
 
 
-class Contact(_Strict):
+class Contact(Strict):
     enabled: bool = True
     stiffness_n_per_cm: Positive = 1000.0
     tolerance_cm: Positive = 0.01
@@ -146,7 +148,7 @@ class Contact(_Strict):
 Pair = Annotated[list[str], Field(min_length=2, max_length=2)]
 
 
-class Group(_Strict):
+class Group(Strict):
     independent: str  # its force is the co-contraction level
     pair: Pair  # the agonist/antagonist pair
 
@@ -155,7 +157,7 @@ JAW_POSITIONS = {"rest": {}, "JO_0.5": {"JO": 0.5}, "JO_1.2": {"JO": 1.2}, "JO_2
                  "JO_6": {"JO": 6.0}, "JC_0.5": {"JC": 0.5}, "JC_1.5": {"JC": 1.5}, "JC_3": {"JC": 3.0}}
 
 
-class EPMapSpec(_Strict):
+class EPMapSpec(Strict):
     """What ``artic ep-map`` computes (the paper's section IV.B)."""
 
     duration_ms: Positive = 300.0  # each equilibrium: the muscle force held this long from the jaw position's rest
@@ -186,7 +188,7 @@ class EPMapSpec(_Strict):
         return v
 
 
-class MuscleFunctionSpec(_Strict):
+class MuscleFunctionSpec(Strict):
     """The paper's section IV.A.1 (Figs. 5 and 6): scattered starts, then one muscle from each."""
 
     start_combinations: list[Annotated[list[str], Field(min_length=1)]] = [
@@ -199,13 +201,13 @@ class MuscleFunctionSpec(_Strict):
     contact: bool = False  # the paper left the wall out of this study
 
 
-class Cuboid(_Strict):
+class Cuboid(Strict):
     size_cm: Point3 = [6.0, 3.0, 2.0]
     bricks: Annotated[list[int], Field(min_length=3, max_length=3)] = [5, 3, 2]
     forces_n: list[NonNeg] = [0.1, 0.5, 1.0, 2.0, 3.0, 4.0]
 
 
-class Config(_Strict):
+class Config(Strict):
     schema_version: Literal[1]
     speaker: Speaker
     materials: Materials

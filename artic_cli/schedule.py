@@ -20,33 +20,29 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Annotated
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import Field, ValidationError
 
-from .config import read_yaml
+from .config import Strict, read_yaml
 from .errors import ArticError
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 
 
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
-
-
-class LoadEntry(_Strict):
+class LoadEntry(Strict):
     nodes: str
     force_n: Annotated[list[Finite], Field(min_length=3, max_length=3)]
     onset_ms: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 0.0
     duration_ms: Annotated[float, Field(gt=0, allow_inf_nan=False)]
 
 
-class MuscleEntry(_Strict):
+class MuscleEntry(Strict):
     muscle: str
     force_n: Annotated[float, Field(ge=0, allow_inf_nan=False)]
     onset_ms: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 0.0
     duration_ms: Annotated[float, Field(gt=0, allow_inf_nan=False)]
 
 
-class Schedule(_Strict):
+class Schedule(Strict):
     duration_ms: Annotated[float, Field(gt=0, allow_inf_nan=False)] | None = None
     muscles: list[MuscleEntry] = []
     loads: list[LoadEntry] = []

@@ -362,6 +362,9 @@ def dynamic_map_cmd(
     from ..control.dynamic import table_iv
     from ..stages.dynamic import build_dynamic_map
 
+    from ..stages.dynamic import fresh_recipe
+
+    fresh = fresh_recipe(maps, out)
     dm = build_dynamic_map(maps, out)
     rows = table_iv(dm)
     if as_json:
@@ -378,7 +381,7 @@ def dynamic_map_cmd(
                       f(r["paper_tip_cm"]), f(r["error_dorsum_cm"]), f(r["paper_dorsum_cm"]),
                       "" if r["loo_tip_cm"] is None else f"{r['loo_tip_cm']:.3f} / {r['loo_dorsum_cm']:.3f}")
     out_console.print(table)
-    out_console.print(f"wrote {out}", highlight=False)
+    out_console.print(f"{out} is up to date (same EP maps and code)" if fresh else f"wrote {out}", highlight=False)
 
 
 @app.command("solve-target")
@@ -425,6 +428,7 @@ def solve_target_cmd(
                                     "" if sim is None else sim.mesh_sha256)
     if fresh:
         out_console.print(f"{path} is up to date (same maps, target, options and code)", highlight=False)
+        return
     ch = doc["chosen"]
     forces = ", ".join(f"{k} {v:g} N" for k, v in ch["forces_n"].items())
     out_console.print(f"{t.name}: {ch['family']} {ch['map']}: {forces}; predicted tip {ch['predicted_cm']['tip']}, "

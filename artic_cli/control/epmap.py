@@ -25,7 +25,7 @@ import numpy as np
 
 from ..config import Config, EPMapSpec
 from ..errors import ArticError
-from ..geometry.anatomy import JAW_MUSCLES, TONGUE_MUSCLES
+from ..geometry.anatomy import JAW_MUSCLES, TONGUE_MUSCLES, check_muscle_names
 from ..mechanics.model import CONTROL_POINTS
 from .equilibrium import EP, Forces, add_forces, canonical
 
@@ -63,20 +63,11 @@ def check_spec(cfg: Config) -> None:
     where = [("epmap.muscles", spec.muscles)]
     where += [("epmap.pairs_tip", p) for p in spec.pairs_tip] + [("epmap.pairs_dorsum", p) for p in spec.pairs_dorsum]
     where += [("epmap.groups", [g.independent, *g.pair]) for g in spec.groups]
+    where += [(f"epmap.jaw_positions.{name}", list(forces)) for name, forces in spec.jaw_positions.items()]
     for key, names in where:
-        for name in names:
-            if name not in valid:
-                raise ArticError(f"config: {key} names unknown muscle '{name}'; valid: {', '.join(valid)}")
+        check_muscle_names(names, valid, key)
     for key, names in (("epmap.typical_jaw", [spec.typical_jaw]), ("epmap.net_jaw_positions", spec.net_jaw_positions)):
-        for name in names:
-            if name not in spec.jaw_positions:
-                raise ArticError(f"config: {key} names unknown jaw position '{name}'; "
-                                 f"valid: {', '.join(spec.jaw_positions)}")
-    for name, forces in spec.jaw_positions.items():
-        for m in forces:
-            if m not in valid:
-                raise ArticError(f"config: epmap.jaw_positions.{name} names unknown muscle '{m}'; "
-                                 f"valid: {', '.join(valid)}")
+        check_muscle_names(names, list(spec.jaw_positions), key, "jaw position")
     if 0.0 not in spec.levels_n:
         raise ArticError("config: epmap.levels_n must include 0.0 (the rest of each vector)")
 

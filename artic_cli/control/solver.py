@@ -26,8 +26,9 @@ from dataclasses import dataclass, field
 from typing import Annotated, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import Field, ValidationError
 
+from ..config import Strict
 from ..errors import ArticError, UnreachableTarget
 from .epmap import CONTROL_POINTS, JawMaps, Net
 
@@ -35,28 +36,24 @@ Point2 = Annotated[list[float], Field(min_length=2, max_length=2)]
 POINT = Literal["tip", "dorsum"]
 
 
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
-
-
-class JawSpec(_Strict):
+class JawSpec(Strict):
     forces_n: dict[Literal["JO", "JC"], Annotated[float, Field(ge=0, allow_inf_nan=False)]] | None = None
     opening_cm: Annotated[float, Field(allow_inf_nan=False)] | None = None  # incisor height relative to rest
 
 
-class Crucial(_Strict):
+class Crucial(Strict):
     point: POINT
     at_cm: Point2
     tolerance_cm: Annotated[float, Field(gt=0, allow_inf_nan=False)] = 0.05
 
 
-class Indecisive(_Strict):
+class Indecisive(Strict):
     point: POINT
     at_cm: Point2
     weight: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 1.0
 
 
-class TargetSpec(_Strict):
+class TargetSpec(Strict):
     name: str = "target"
     jaw: JawSpec = JawSpec(forces_n={"JO": 0.5})
     crucial: Crucial

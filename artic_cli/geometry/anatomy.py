@@ -9,10 +9,11 @@ Mandible (paper Fig. 2f): four nodes a side (condyle, coronoid, gonion,
 symphysis) joined by five stiff links, two triangles (condyle-coronoid-gonion,
 coronoid-gonion-symphysis) sharing the shearing link coronoid-gonion; the two
 sides are tied by cross links so that the jaw is rigid in 3D.  Carried by
-the mandible (stiff links to four jaw nodes): the lower incisor point (the
-jaw control point), the geniohyoid origin, the mylohyoid line and the
-tongue's innermost concentric line (the genioglossus tendon at the genial
-tubercles).  Hyoid: body (two nodes) and two greater horns, braced.  The
+the mandible (each a fixed affine combination of four mandible nodes, so it
+moves rigidly with them and has no degrees of freedom of its own): the lower
+incisor point (the jaw control point), the geniohyoid origin, the mylohyoid
+line, the digastric fossae and the tongue's innermost concentric line (the
+genioglossus tendon at the genial tubercles).  Hyoid: body (two nodes) and two greater horns, braced.  The
 tongue floor line rests on the hyoid and mandible through soft links.
 """
 
@@ -30,6 +31,14 @@ LINK_KINDS = ("mandible", "hyoid", "floor", "strap")
 TONGUE_MUSCLES = ("GGa", "GGm", "GGp", "HG", "SG", "SL", "IL", "T", "V", "GH", "MH")
 JAW_MUSCLES = ("temporalis_anterior", "temporalis_posterior", "masseter", "medial_pterygoid",
                "lateral_pterygoid_upper", "lateral_pterygoid_lower", "anterior_digastric", "posterior_digastric")
+
+
+def check_muscle_names(names, valid, key: str, what: str = "muscle") -> None:
+    """One ArticError naming the first of ``names`` not in ``valid``, the config key it sits under, and the
+    valid names."""
+    for name in names:
+        if name not in valid:
+            raise ArticError(f"config: {key} names unknown {what} '{name}'; valid: {', '.join(valid)}")
 
 
 @dataclass(frozen=True)

@@ -1,7 +1,13 @@
-"""Compiled inner loops (numba) for the two hottest pieces of a time step.
+"""Compiled inner loops (numba) of a time step, each the same numbers as its numpy counterpart (tests compare).
 
-Both compute exactly what the numpy code in :mod:`.elements` computes (a test compares them); they fuse the
-dozens of array passes over the ~2200 cylinders into one loop each.  Without numba the numpy path runs.
+* cylinders and links: state (length, strain, modulus), nodal forces, and the tangent's 3x3 blocks per node
+  pair (``cylinder_state``, ``cylinder_forces``, ``node_blocks``);
+* bricks: volume and inversion-guard terms with their gradients (``brick_terms``);
+* the wall: exact candidate grids and the closest triangle of each point, and the mandible's rigid motion
+  (``grid_candidates``, ``wall_nearest``, ``rigid_motion``);
+* muscle fibres: segment geometry and nodal forces (``fibre_geometry``, ``fibre_forces``).
+
+Without numba the functions run as plain Python (slowly); numba is a dependency.
 """
 
 from __future__ import annotations

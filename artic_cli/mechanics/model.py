@@ -23,7 +23,7 @@ import scipy.sparse as sp
 from .. import units
 from ..config import Config, Simulation, TissueMaterial
 from ..errors import ArticError
-from ..geometry.anatomy import JAW_MUSCLES, LINK_KINDS, TONGUE_MUSCLES, Body, build_body
+from ..geometry.anatomy import JAW_MUSCLES, LINK_KINDS, TONGUE_MUSCLES, Body, build_body, check_muscle_names
 from ..geometry.hexahedra import corner_jacobians, volumes
 from ..geometry.mesh import Mesh
 from ..geometry.wall import WallSurface
@@ -363,13 +363,9 @@ def build_articulator(cfg: Config, mesh: Mesh, wall: WallSurface | None = None, 
     missing = [m for m in names if m not in mc.thickness_cm2]
     if missing:
         raise ArticError(f"config: muscles.thickness_cm2 lacks {', '.join(missing)}; add a thickness for each")
-    unknown = [m for m in mc.thickness_cm2 if m not in names]
-    if unknown:
-        raise ArticError(f"config: muscles.thickness_cm2 has unknown muscle '{unknown[0]}'; valid: {', '.join(names)}")
+    check_muscle_names(mc.thickness_cm2, names, "muscles.thickness_cm2")
     for g, members in mc.groups.items():
-        bad = [m for m in members if m not in names]
-        if bad:
-            raise ArticError(f"config: muscles.groups.{g} names unknown muscle '{bad[0]}'; valid: {', '.join(names)}")
+        check_muscle_names(members, names, f"muscles.groups.{g}")
     ms = muscle_set(names, body.fibres, body.fibre_weight, mc.thickness_cm2, body.nodes,
                     k1=mc.passive_k1_ratio * e0, k2=mc.maxwell_k2_ratio * e0,
                     b2=mc.maxwell_b2_ratio * units.kpa_to_cgs(tissue.viscosity_kpa_s))
@@ -395,10 +391,8 @@ def build_articulator(cfg: Config, mesh: Mesh, wall: WallSurface | None = None, 
     tone = np.zeros(len(names))
     for name, fn in mc.postural_tone_n.items():
         members = mc.groups.get(name, {name: 1.0})
+        check_muscle_names(members, names, "muscles.postural_tone_n")
         for m, w in members.items():
-            if m not in names:
-                raise ArticError(f"config: muscles.postural_tone_n names unknown muscle '{m}'; "
-                                 f"valid: {', '.join(names + list(mc.groups))}")
             tone[names.index(m)] += units.newton_to_dyn(fn) * w
     return _finish(mesh, body.nodes.copy(), cyl, link_mass, kappa, fixed, cfg.simulation, g, len(mesh.nodes),
                    bulk_ratio * scale * e0,

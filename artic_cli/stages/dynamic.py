@@ -58,10 +58,18 @@ def read(path: Path | str, maps_path: Path | str | None = None) -> DynamicMap:
             raise ArticError(f"{path} is damaged or incomplete ({type(err).__name__}); {hint}") from None
 
 
+def _provenance(maps: Path | str):
+    return STAGE.provenance(None, inputs={"epmaps": content_hash_of(maps, "epmap", epmap_stage.STAGE.hint)})
+
+
+def fresh_recipe(maps: Path | str, out: Path | str) -> bool:
+    """Whether ``out`` already holds the dynamic map of ``maps``."""
+    return up_to_date(out, _provenance(maps))
+
+
 def build_dynamic_map(maps: Path | str = "data/epmaps.h5", out: Path | str = "data/dynamic.h5") -> DynamicMap:
     """Fit the dynamic map to an EP-map file; ``out`` is left alone when it already holds this recipe."""
-    maps_sha = content_hash_of(maps, "epmap", epmap_stage.STAGE.hint)
-    prov = STAGE.provenance(None, inputs={"epmaps": maps_sha})
+    prov = _provenance(maps)
     if up_to_date(out, prov):
         return read(out)
     dm = compute(epmap_stage.read(maps))

@@ -16,6 +16,7 @@ import numpy as np
 from ..config import Config, load_config
 from ..control.epmap import canonical, drivable_names
 from ..errors import ArticError
+from ..geometry.anatomy import check_muscle_names
 from ..experiments.muscle_function import MuscleFunction, model_and_rest, run_start, starts
 from ..control.equilibrium import watch_nodes
 from ..io.fingerprint import code_hash, digest, sections_hash
@@ -35,9 +36,7 @@ def check_spec(cfg: Config) -> None:
     valid = drivable_names(cfg)
     for key_name, names in [("muscle_function.muscles", spec.muscles),
                             *[("muscle_function.start_combinations", c) for c in spec.start_combinations]]:
-        for n in names:
-            if n not in valid:
-                raise ArticError(f"config: {key_name} names unknown muscle '{n}'; valid: {', '.join(valid)}")
+        check_muscle_names(names, valid, key_name)
 
 
 def compute(cfg: Config, mesh, wall, mesh_sha: str, sweep: Sweep) -> tuple[MuscleFunction, int, int]:

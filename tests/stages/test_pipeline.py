@@ -71,6 +71,36 @@ def test_a_second_run_does_nothing(built):
     assert res.returncode == 0, res.stdout + res.stderr  # -q: everything is up to date
 
 
+DATA_COMMANDS = ("artic build-mesh", "artic simulate", "artic validate", "artic experiment", "artic ep-map",
+                 "artic muscle-function", "artic dynamic-map", "artic solve-target")
+
+
+def _mtimes(out):
+    return {p: p.stat().st_mtime_ns for p in out.rglob("*") if p.suffix in (".h5", ".json", ".yaml")
+            and ".config" not in p.parts}
+
+
+def test_a_plotting_edit_redraws_figures_and_recomputes_nothing(built):
+    before = _mtimes(built)
+    # -W: make sees the plotting module as just edited (a comment edit, as far as make can tell)
+    res = make("paper", "CONFIG=configs/ci_thin.yaml", f"OUT={built}", "-W", "artic_cli/plots/common.py")
+    assert res.returncode == 0, res.stdout[-3000:] + res.stderr[-3000:]
+    ran = [ln for ln in res.stdout.splitlines() if "bin/artic " in ln]
+    assert any("artic plot " in ln for ln in ran) and any("artic report" in ln for ln in ran)
+    assert not [ln for ln in ran if any(c in ln for c in DATA_COMMANDS)]
+    assert _mtimes(built) == before
+
+
+def test_a_touched_physics_module_reruns_stages_that_find_themselves_up_to_date(built):
+    before = _mtimes(built)
+    # the equilibrium code: make reruns the EP maps and what reads it, each finds its recipe unchanged
+    res = make("paper", "CONFIG=configs/ci_thin.yaml", f"OUT={built}", "-W", "artic_cli/control/equilibrium.py")
+    assert res.returncode == 0, res.stdout[-3000:] + res.stderr[-3000:]
+    assert "artic ep-map" in res.stdout and "epmaps.h5 is up to date" in res.stdout
+    assert "equilibria (" not in res.stdout  # no equilibrium computed, none even looked up
+    assert _mtimes(built) == before  # same content: every artefact keeps its time, nothing downstream reruns
+
+
 def test_a_missing_config_stops_the_first_stage(tmp_path):
     res = make("paper", "CONFIG=configs/missing.yaml", f"OUT={tmp_path}")
     assert res.returncode != 0
