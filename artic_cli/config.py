@@ -9,28 +9,20 @@ its freshness key leaves out.
 
 from __future__ import annotations
 
-import difflib
 from pathlib import Path
 from typing import Annotated, Literal
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+from pydantic import Field, ValidationError, field_validator
 
 from .errors import ArticError
+from .validation import DEFAULT_MAX_FORCE_N, Finite, Point2, Point3, Strict, describe, parse
 
 DEFAULT_CONFIG = Path(__file__).resolve().parent.parent / "configs" / "default.yaml"
 
-Point2 = Annotated[list[float], Field(min_length=2, max_length=2)]
-Point3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 Outline = Annotated[list[Point2], Field(min_length=2)]
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 NonNeg = Annotated[float, Field(ge=0, allow_inf_nan=False)]
-
-
-class Strict(BaseModel):
-    """A user-facing YAML record: unknown keys are errors, values frozen once validated."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True)
 
 
 class TongueGeometry(Strict):
@@ -38,7 +30,7 @@ class TongueGeometry(Strict):
     gg_origin_cm: Point2
     half_width_cm: Positive = 1.0
     parasagittal_shrink: Annotated[float, Field(ge=0, lt=0.5)] = 0.08
-    parasagittal_drop_cm: float = 0.15
+    parasagittal_drop_cm: Finite = 0.15
     parasagittal_tip_recess_cm: NonNeg = 0.0
     tip_taper_sections: Annotated[int, Field(ge=1, le=20)] = 3
     radial_sections: Annotated[int, Field(ge=2, le=40)] = 10
@@ -125,6 +117,7 @@ class Muscles(Strict):
     # Steady force (N) of muscles or groups in every state, on top of the control: the jaw closers'
     # postural tone holds the mandible at its reference height against gravity.
     postural_tone_n: dict[str, NonNeg] = {"JC": 2.1}
+    max_force_n: Positive = DEFAULT_MAX_FORCE_N  # the largest force a schedule or target may ask of a muscle or load
 
 
 class Jaw(Strict):
@@ -221,43 +214,13 @@ class Config(Strict):
 
 
 
-def _known_keys(model: type[BaseModel]) -> set[str]:
-    return set(model.model_fields)
-
-
-def _format_error(path: Path, err: ValidationError) -> str:
-    first = err.errors()[0]
-    loc = ".".join(str(p) for p in first["loc"])
-    kind = first["type"]
-    if kind == "extra_forbidden":
-        # suggest the closest known key at that level
-        parent_loc = first["loc"][:-1]
-        model: type[BaseModel] = Config
-        for part in parent_loc:
-            field = model.model_fields.get(str(part)) if isinstance(part, str) else None
-            ann = getattr(field, "annotation", None) if field else None
-            if isinstance(ann, type) and issubclass(ann, BaseModel):
-                model = ann
-            else:
-                args = getattr(ann, "__args__", ()) if ann is not None else ()
-                sub = [a for a in args if isinstance(a, type) and issubclass(a, BaseModel)]
-                if sub:
-                    model = sub[0]
-        close = difflib.get_close_matches(str(first["loc"][-1]), _known_keys(model), n=1)
-        hint = f" (did you mean '{close[0]}'?)" if close else ""
-        return f"{path}: unknown key '{loc}'{hint}"
-    if kind == "missing":
-        return f"{path}: missing key '{loc}'"
-    return f"{path}: key '{loc}': {first['msg']}"
-
-
 def parse_config(data: object, source: Path | str = "<config>") -> Config:
     if not isinstance(data, dict):
         raise ArticError(f"{source}: config must be a YAML mapping; see configs/default.yaml")
     try:
         return Config.model_validate(data)
     except ValidationError as err:
-        raise ArticError("config error: " + _format_error(Path(source), err) + "; fix the key and rerun") from None
+        raise ArticError("config error: " + describe(err, Config, str(source)) + "; fix the key and rerun") from None
 
 
 def read_yaml(path: Path | str, what: str = "file") -> object:
@@ -278,11 +241,7 @@ def load_config(path: Path | str | None = None) -> Config:
 
 
 def parse_speaker(data: object, source: str = "<speaker>") -> Speaker:
-    try:
-        return Speaker.model_validate(data)
-    except ValidationError as err:
-        first = err.errors()[0]
-        raise ArticError(f"{source}: key 'speaker.{'.'.join(map(str, first['loc']))}': {first['msg']}") from None
+    return parse(Speaker, data, source, "speaker section", "rebuild the mesh with 'artic build-mesh'")
 
 
 SECTIONS = tuple(Config.model_fields)

@@ -1,4 +1,4 @@
-"""Errors a user can act on.  The CLI turns them into one line and exit 2."""
+"""Errors a user can act on.  The CLI turns each into one line and its exit status."""
 
 
 class ArticError(Exception):
@@ -11,3 +11,10 @@ class UnreachableTarget(ArticError):
     """A target outside the reachable region (exit status 3)."""
 
     exit_code = 3
+
+
+class NotPhysical(ArticError):
+    """A result that is not physical (NaN, an inverted brick, a Newton failure, lost volume): its file is
+    written and marked invalid (exit status 4)."""
+
+    exit_code = 4

@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Callable, Iterator, Sequence
 
 from .errors import ArticError
+from .validation import check_number
 
 
 @contextlib.contextmanager
@@ -22,8 +23,7 @@ def parallel_backend(backend: str, jobs: int, scheduler: str | None) -> Iterator
     loopback without ``scheduler``)."""
     from joblib import parallel_config
 
-    if jobs < 1:
-        raise ArticError(f"--jobs must be at least 1, got {jobs}")
+    check_number("--jobs", jobs, ge=1)
     if backend == "loky":
         if scheduler:
             raise ArticError("--scheduler needs --backend dask")

@@ -19,17 +19,15 @@ import json
 import sys
 from pathlib import Path
 
-from pydantic import BaseModel, ConfigDict, ValidationError
-
 from .config import SECTIONS, load_config, read_yaml
 from .errors import ArticError
 from .io.fingerprint import module_closure, module_path
+from .validation import Strict, parse
 
 ROOT = Path(__file__).resolve().parent.parent
 
 
-class Pipeline(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+class Pipeline(Strict):
     pipeline: str
     tissue_schedules: list[str] = []
     tissue_without_constraint: list[str] = []
@@ -40,12 +38,7 @@ class Pipeline(BaseModel):
 
 
 def load_pipeline(path: Path | str) -> Pipeline:
-    data = read_yaml(path, "pipeline")
-    try:
-        p = Pipeline.model_validate(data)
-    except ValidationError as err:
-        first = err.errors()[0]
-        raise ArticError(f"{path}: key '{'.'.join(map(str, first['loc']))}': {first['msg']}") from None
+    p = parse(Pipeline, read_yaml(path, "pipeline"), str(path), "pipeline definition", "fix it and rerun make")
     from .experiments.paper import EXPERIMENTS
 
     for name in p.tissue_schedules + p.tissue_without_constraint + p.articulator_schedules + p.animated:

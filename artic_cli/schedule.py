@@ -20,30 +20,39 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Annotated
 
-from pydantic import Field, ValidationError
+from pydantic import Field, ValidationInfo, field_validator
 
-from .config import Strict, read_yaml
+from .config import read_yaml
 from .errors import ArticError
-
-Finite = Annotated[float, Field(allow_inf_nan=False)]
+from .validation import DEFAULT_MAX_FORCE_N, DurationMs, ForceN, LoadN, OnsetMs, Strict, parse
 
 
 class LoadEntry(Strict):
     nodes: str
-    force_n: Annotated[list[Finite], Field(min_length=3, max_length=3)]
-    onset_ms: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 0.0
-    duration_ms: Annotated[float, Field(gt=0, allow_inf_nan=False)]
+    force_n: Annotated[list[LoadN], Field(min_length=3, max_length=3)]
+    onset_ms: OnsetMs = 0.0
+    duration_ms: DurationMs
+
+    @field_validator("force_n")
+    @classmethod
+    def _capped(cls, v, info: ValidationInfo):
+        cap = (info.context or {}).get("max_force_n", DEFAULT_MAX_FORCE_N)
+        size = sum(c * c for c in v) ** 0.5
+        if size > cap:
+            raise ValueError(f"a {size:g}-N load is above the {cap:g}-N cap (raise muscles.max_force_n in the config "
+                             "if you mean it)")
+        return v
 
 
 class MuscleEntry(Strict):
     muscle: str
-    force_n: Annotated[float, Field(ge=0, allow_inf_nan=False)]
-    onset_ms: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 0.0
-    duration_ms: Annotated[float, Field(gt=0, allow_inf_nan=False)]
+    force_n: ForceN
+    onset_ms: OnsetMs = 0.0
+    duration_ms: DurationMs
 
 
 class Schedule(Strict):
-    duration_ms: Annotated[float, Field(gt=0, allow_inf_nan=False)] | None = None
+    duration_ms: DurationMs | None = None
     muscles: list[MuscleEntry] = []
     loads: list[LoadEntry] = []
 
@@ -70,25 +79,16 @@ class Schedule(Strict):
                                      "give one entry per interval")
 
 
-def parse_schedule(data: object, source: str = "<schedule>") -> Schedule:
+def parse_schedule(data: object, source: str = "<schedule>", max_force_n: float = DEFAULT_MAX_FORCE_N) -> Schedule:
+    """A schedule from YAML data; muscle and load forces above ``max_force_n`` (N) are refused."""
     if data is None:
         data = {}
-    if not isinstance(data, dict):
-        raise ArticError(f"{source}: a schedule must be a YAML mapping with a 'loads' list")
-    try:
-        return Schedule.model_validate(data)
-    except ValidationError as err:
-        first = err.errors()[0]
-        loc = ".".join(str(p) for p in first["loc"])
-        if first["type"] == "extra_forbidden":
-            raise ArticError(f"schedule error: {source}: unknown key '{loc}'; valid keys are duration_ms, muscles "
-                             "(muscle, force_n, onset_ms, duration_ms), loads (nodes, force_n, onset_ms, "
-                             "duration_ms)") from None
-        raise ArticError(f"schedule error: {source}: key '{loc}': {first['msg']}") from None
+    return parse(Schedule, data, source, "schedule (with 'muscles' and/or 'loads' lists)",
+                 "fix the schedule and rerun", context={"max_force_n": max_force_n})
 
 
-def load_schedule(path: Path | str) -> Schedule:
-    return parse_schedule(read_yaml(path, "schedule"), str(path))
+def load_schedule(path: Path | str, max_force_n: float = DEFAULT_MAX_FORCE_N) -> Schedule:
+    return parse_schedule(read_yaml(path, "schedule"), str(path), max_force_n)
 
 
 __all__ = ["Schedule", "LoadEntry", "MuscleEntry", "load_schedule", "parse_schedule"]

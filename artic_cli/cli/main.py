@@ -2,7 +2,8 @@
 
 Each command is a thin shell over a stage module (:mod:`artic_cli.stages`) or
 a plot.  Exit statuses: 0 done, 2 bad input (one line on stderr), 3 target
-not reached (the answer is written), 130 interrupted.
+not reached (the answer is written), 4 result not physical (the file is
+written and marked invalid), 130 interrupted.
 """
 
 from __future__ import annotations
@@ -21,9 +22,14 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 
 from ..errors import ArticError
+from ..validation import DEFAULT_MAX_FORCE_N, check_number
 
+EXIT_STATUSES = ("Exit status: 0 done; 2 bad input (one line names the problem and the fix, nothing written); "
+                 "3 target not reached (the answer is written); 4 result not physical (the file is written and "
+                 "marked invalid); 130 interrupted.")
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
-                  help="A physiological articulatory model of the tongue, jaw and hyoid (after Dang & Honda 2004).")
+                  help="A physiological articulatory model of the tongue, jaw and hyoid (after Dang & Honda 2004).",
+                  epilog=EXIT_STATUSES)
 validate_app = typer.Typer(no_args_is_help=True, help="Check the tissue model against the paper's test bodies.")
 app.add_typer(validate_app, name="validate", help="Check the tissue model against the paper's test bodies (cuboid).")
 plot_app = typer.Typer(no_args_is_help=True, help="Pictures of the artefacts.")
@@ -167,6 +173,7 @@ def simulate_cmd(
     if r.up_to_date:
         out_console.print(f"{r.path} is up to date (same mesh, config sections, schedule, options and code); "
                           f"max |volume change| {100 * r.max_volume_change:.3f} %", highlight=False)
+        _refuse_unphysical(r)
         return
     t = r.trajectory
     sim_time = t.time[-1] - t.time[0]
@@ -176,6 +183,15 @@ def simulate_cmd(
         f"{100 * r.max_volume_change:.3f} % (constraint {'on' if r.model.volume_constraint else 'off'}), "
         f"inverted bricks {int(t.inverted.max())}" + (f"; figure {plot}" if plot else "")
         + (f"; animation {animate}" if animate else ""), highlight=False)
+    _refuse_unphysical(r)
+
+
+def _refuse_unphysical(r) -> None:
+    if r.problems:
+        from ..errors import NotPhysical
+
+        raise NotPhysical(f"{r.path} is not physical and is marked invalid: {'; '.join(r.problems)}; lower the "
+                          "forces or the step (--dt) and rerun")
 
 
 @validate_app.command("cuboid")
@@ -188,12 +204,9 @@ def validate_cuboid_cmd(
     out: Optional[Path] = typer.Option(None, "--out", help="Also write the rows as JSON to this file."),
 ):
     """Pull the paper's 6 x 3 x 2 cm cuboid: strains, Poisson ratio (Eq. 4), volume change."""
-    import math
 
-    if force is not None:
-        bad = [f for f in force if not math.isfinite(f) or f < 0]
-        if bad:
-            raise ArticError(f"--force must be finite and non-negative (N), got {bad[0]}")
+    for f in force or []:
+        check_number("--force", f, ge=0, le=DEFAULT_MAX_FORCE_N, unit="N")
     from ..stages.cuboid import validate_cuboid
 
     dicts = validate_cuboid(config, force, volume_constraint, out)
@@ -408,12 +421,12 @@ def solve_target_cmd(
 
     if (target is None) == (batch is None):
         raise ArticError("give a target file or --batch CSV (one of them)")
-    if budget < 1:
-        raise ArticError(f"--budget must be at least 1, got {budget}")
+    check_number("--budget", budget, ge=1)
+    check_number("--jobs", jobs, ge=1)
+    targets = read_batch(batch) if batch is not None else [load_target(target)]  # the user's file first
     ctx = load_context(maps, dynamic, mesh if (verify or refine) else None)
     sim = simulator(mesh, config) if (verify or refine) else None
     if batch is not None:
-        targets = read_batch(batch)
         args = None if sim is None else (sim.cfg, sim.mesh, sim.wall, sim.mesh_sha256)
         res = _with_progress("targets", lambda update: solve_batch(ctx, targets, jobs, args, verify, refine, budget,
                                                                    update), plain=True)
@@ -423,7 +436,7 @@ def solve_target_cmd(
         out_console.print(f"wrote {path}: {len(res)} targets, {len(res) - bad} solved, {bad} unreachable",
                           highlight=False)
         return
-    t = load_target(target)
+    t = targets[0]
     doc, path, fresh = solve_target(t, ctx, out, sim, verify, refine, budget, config,
                                     "" if sim is None else sim.mesh_sha256)
     if fresh:
@@ -469,8 +482,7 @@ def export_cmd(
         raise ArticError("nothing to export; give --vtk FOLDER and/or --csv FILE")
     if csv_out is not None and sim is None:
         raise ArticError("--csv exports a simulation's control points; give --sim FILE.h5")
-    if every < 1:
-        raise ArticError(f"--every must be at least 1, got {every}")
+    check_number("--every", every, ge=1)
     written = []
     if vtk is not None:
         written += export_mesh_vtk(mesh, vtk)
@@ -569,7 +581,7 @@ def _plot_mesh(mesh: Path, out: Path) -> Path:
 def _plot_simulation(sim: Path, model, wall, plot: Path | None, animate: Path | None) -> None:
     from ..stages.simulate import read
 
-    s = read(sim)
+    s = read(sim, allow_invalid=True)
     traj = SimpleNamespace(x=s.positions_cm, time=s.time_s)
     if plot:
         from ..plots.simulation import plot_simulation
@@ -614,7 +626,11 @@ def plot_simulation_cmd(
 
     if out is None and animate is None:
         raise ArticError("nothing to draw; give --out PNG and/or --animate GIF")
-    tongue_only = bool(read(sim).attrs.get("tongue_only", False))
+    s = read(sim, allow_invalid=True)
+    if not s.attrs.get("valid", True):
+        err_console.print(f"[yellow]warning:[/] {sim} is marked invalid ({s.attrs.get('invalid_reason')}); "
+                          "drawing it anyway", highlight=False)
+    tongue_only = bool(s.attrs.get("tongue_only", False))
     model, _, wall = load_model(mesh, config, tongue_only=tongue_only)
     _plot_simulation(sim, model, wall, out, animate)
     out_console.print("wrote " + ", ".join(str(p) for p in (out, animate) if p), highlight=False)

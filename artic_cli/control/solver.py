@@ -23,60 +23,46 @@ names the nearest reachable point and its distance.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Annotated, Literal
+from typing import Literal
 
 import numpy as np
-from pydantic import Field, ValidationError
 
-from ..config import Strict
+from ..validation import DEFAULT_MAX_FORCE_N, ForceN, NonNegative, Point2, Positive, PositionCm, SafeName, Strict, parse
 from ..errors import ArticError, UnreachableTarget
 from .epmap import CONTROL_POINTS, JawMaps, Net
 
-Point2 = Annotated[list[float], Field(min_length=2, max_length=2)]
 POINT = Literal["tip", "dorsum"]
 
 
 class JawSpec(Strict):
-    forces_n: dict[Literal["JO", "JC"], Annotated[float, Field(ge=0, allow_inf_nan=False)]] | None = None
-    opening_cm: Annotated[float, Field(allow_inf_nan=False)] | None = None  # incisor height relative to rest
+    forces_n: dict[Literal["JO", "JC"], ForceN] | None = None
+    opening_cm: PositionCm | None = None  # incisor height relative to rest
 
 
 class Crucial(Strict):
     point: POINT
     at_cm: Point2
-    tolerance_cm: Annotated[float, Field(gt=0, allow_inf_nan=False)] = 0.05
+    tolerance_cm: Positive = 0.05
 
 
 class Indecisive(Strict):
     point: POINT
     at_cm: Point2
-    weight: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 1.0
+    weight: NonNegative = 1.0
 
 
 class TargetSpec(Strict):
-    name: str = "target"
+    name: SafeName = "target"  # becomes the solution's file name
     jaw: JawSpec = JawSpec(forces_n={"JO": 0.5})
     crucial: Crucial
     indecisive: list[Indecisive] = []
-    force_weight: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 1.0  # per N^2
-    distance_weight: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 100.0  # per cm^2
+    force_weight: NonNegative = 1.0  # per N^2
+    distance_weight: NonNegative = 100.0  # per cm^2
 
 
-def parse_target(data: object, source: str = "<target>") -> TargetSpec:
-    if not isinstance(data, dict):
-        raise ArticError(f"{source}: a target must be a YAML mapping with 'crucial' (and 'jaw', 'indecisive')")
-    try:
-        t = TargetSpec.model_validate(data)
-    except ValidationError as err:
-        first = err.errors()[0]
-        loc = ".".join(str(p) for p in first["loc"])
-        if first["type"] == "literal_error" and loc.endswith("point"):
-            raise ArticError(f"{source}: key '{loc}': no control point {first['input']!r}; valid: tip, dorsum") from None
-        if first["type"] == "extra_forbidden":
-            raise ArticError(f"{source}: unknown key '{loc}'; fix the key and rerun") from None
-        if first["type"] == "missing":
-            raise ArticError(f"{source}: missing key '{loc}'") from None
-        raise ArticError(f"{source}: key '{loc}': {first['msg']}") from None
+def parse_target(data: object, source: str = "<target>", max_force_n: float = DEFAULT_MAX_FORCE_N) -> TargetSpec:
+    t = parse(TargetSpec, data, source, "target (with 'crucial', and 'jaw', 'indecisive')", "fix the target and rerun",
+              context={"max_force_n": max_force_n})
     if (t.jaw.forces_n is None) == (t.jaw.opening_cm is None):
         raise ArticError(f"{source}: key 'jaw': give either forces_n (JO or JC, N) or opening_cm")
     if t.jaw.forces_n is not None and t.jaw.forces_n.get("JO", 0) > 0 and t.jaw.forces_n.get("JC", 0) > 0:

@@ -152,8 +152,9 @@ def content_hash_of(path: Path | str, kind: str, hint: str) -> str:
     return str(v)
 
 
-def open_artifact(path: Path | str, kind: str, hint: str) -> h5py.File:
-    """Open an artefact for reading; any problem is one ArticError naming the fix."""
+def open_artifact(path: Path | str, kind: str, hint: str, allow_invalid: bool = False) -> h5py.File:
+    """Open an artefact for reading; any problem is one ArticError naming the fix.  An artefact marked
+    invalid (``valid = false``: its result is not physical) is refused unless ``allow_invalid``."""
     path = Path(path)
     if not path.is_file():
         raise ArticError(f"{kind} file not found: {path}; {hint}")
@@ -173,6 +174,11 @@ def open_artifact(path: Path | str, kind: str, hint: str) -> h5py.File:
     if version != SCHEMA_VERSION:
         f.close()
         raise ArticError(f"{path} was written with schema version {version}, this artic reads {SCHEMA_VERSION}; {hint}")
+    if not allow_invalid and not bool(f.attrs.get("valid", True)):
+        reason = f.attrs.get("invalid_reason", "")
+        f.close()
+        raise ArticError(f"{path} is marked invalid, its result is not physical ({reason}); fix the run that made "
+                         "it (smaller forces or step) and rerun")
     return f
 
 

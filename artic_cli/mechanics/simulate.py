@@ -13,7 +13,7 @@ from threadpoolctl import threadpool_limits
 
 from ..geometry.hexahedra import corner_jacobians, volumes
 from .elements import strain_energy
-from .integrator import step, total_muscle_force
+from .integrator import SimulationDiverged, step, total_muscle_force
 from .model import Control, Model, State, rest_state, with_options, zero_control
 from .muscles import muscle_lengths, muscle_tensions
 from .volume import volume_energy
@@ -95,8 +95,11 @@ single_threaded = threadpool_limits.wrap(limits=1, user_api="blas")
 @single_threaded
 def run(model: Model, state: State, control_at: Callable[[float], Control], duration: float,
         dt: float | None = None, record_every: int = 1,
-        progress: Callable[[int, int], None] | None = None) -> tuple[Trajectory, State]:
-    """Integrate for ``duration`` seconds; record every ``record_every`` steps."""
+        progress: Callable[[int, int], None] | None = None,
+        keep_partial: bool = False) -> tuple[Trajectory, State]:
+    """Integrate for ``duration`` seconds; record every ``record_every`` steps.  A step that fails
+    (:class:`SimulationDiverged`) raises, or with ``keep_partial`` ends the run there: the trajectory up to the
+    last good step is returned with the failure in ``stats["failure"]``."""
     h = float(model.options.dt if dt is None else dt)
     n_steps = max(1, int(round(duration / h)))
     times, xs, vs, its = [state.t], [state.x.copy()], [state.v.copy()], [0]
@@ -114,10 +117,18 @@ def run(model: Model, state: State, control_at: Callable[[float], Control], dura
     w = 0.0
     gravity = model.node_mass[:, None] * model.gravity
     t0 = time.perf_counter()
+    failure, done = None, 0
     with gc_paused():
         for k in range(1, n_steps + 1):
             ctl = control_at(state.t + 0.5 * h)  # inputs held over the step, sampled at its middle
-            new = step(model, state, ctl, h)
+            try:
+                new = step(model, state, ctl, h)
+            except SimulationDiverged as err:
+                if not keep_partial:
+                    raise
+                failure = str(err)
+                break
+            done = k
             # work of the external forces (held over the step) and gravity
             w += float(np.einsum("ij,ij->", ctl.node_force + gravity, new.x - state.x))
             state = new
@@ -140,9 +151,9 @@ def run(model: Model, state: State, control_at: Callable[[float], Control], dura
     energy = mechanical_energy(model, x, v)
     traj = Trajectory(time=np.array(times), x=x, v=v, volume=vol, iterations=np.array(its),
                       energy=energy - energy[0], work=np.array(work), inverted=inv,
-                      stats={"steps": n_steps, "dt": h, "wall_time_s": wall, "refactors": state.refactors,
+                      stats={"steps": done, "dt": h, "wall_time_s": wall, "refactors": state.refactors,
                              "newton_iterations": int(np.sum(its)),
-                             "diagnostics_time_s": time.perf_counter() - t0 - wall},
+                             "diagnostics_time_s": time.perf_counter() - t0 - wall, "failure": failure},
                       contact_count=np.array([len(c) for c in c_nodes]),
                       contact_total=np.array([float(np.sum(c)) for c in c_forces]),
                       contact_nodes=c_nodes, contact_forces=c_forces, projected=np.array(proj))

@@ -26,6 +26,7 @@ from ..io.fingerprint import code_hash, digest, sections_hash
 from ..io.store import atomic_h5, open_artifact
 from ..mechanics.model import ARTICULATOR_SECTIONS
 from ..parallel import Sweep, run_sweep
+from ..validation import check_number
 from . import mesh as mesh_stage
 from .base import Stage, up_to_date
 
@@ -90,8 +91,7 @@ def build_ep_maps(mesh: Path | str = "data/mesh.h5", config: Path | str | None =
     cfg = load_config(config)
     check_spec(STAGE.view(cfg))
     m = mesh_stage.read(mesh, cfg)  # a stale or foreign mesh fails here, in one line
-    if jobs < 1:
-        raise ArticError(f"--jobs must be at least 1, got {jobs}")
+    check_number("--jobs", jobs, ge=1)
     out = Path(out)
     prov = STAGE.provenance(cfg, inputs={"mesh": m.content_sha256}, params={"fast": fast},
                             code_roots=(EQUILIBRIUM,))

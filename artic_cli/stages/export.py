@@ -58,7 +58,7 @@ def export_mesh_vtk(mesh_path: Path | str, out_dir: Path | str) -> list[Path]:
 
 
 def _read_sim(sim_path: Path | str):
-    s = read_simulation(sim_path)
+    s = read_simulation(sim_path, allow_invalid=True)
     return s.time_s, s.positions_cm, s.velocities_cm_s, s.control_points
 
 

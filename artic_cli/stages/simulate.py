@@ -6,8 +6,7 @@
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
 
@@ -19,6 +18,7 @@ from ..errors import ArticError
 from ..geometry.wall import WallSurface
 from ..io.fingerprint import digest, sections_hash
 from ..io.store import Provenance, atomic_h5, open_artifact
+from ..validation import check_number
 from ..mechanics.loads import load_program
 from ..mechanics.model import ARTICULATOR_SECTIONS, Model, build_articulator, build_model, rest_state
 from ..mechanics.simulate import Trajectory, run, settle
@@ -55,13 +55,30 @@ def run_simulation(model: Model, schedule: Schedule, duration_s: float, dt_s: fl
     program = load_program(model, schedule, source)
     start = rest_state(model) if tongue_only else settle(model)
     traj, _ = run(model, start, program.control_at, duration_s, dt_s, record_every=record_every,
-                  progress=progress)
+                  progress=progress, keep_partial=True)
     return traj
 
 
-def _positive(name: str, value: float | None) -> None:
-    if value is not None and (not math.isfinite(value) or value <= 0):
-        raise ArticError(f"{name} must be a positive number of seconds, got {value}")
+MIN_DT_S = 1e-6  # a step below a microsecond is a typo, not a simulation
+MAX_DURATION_S = 60.0
+VOLUME_LIMIT = 0.01  # a run with the volume constraint on that changes the tongue's volume more than this is not physical
+
+
+def problems(traj: Trajectory, volume_constraint: bool) -> list[str]:
+    """Why a trajectory is not physical (empty when it is): NaN, inverted bricks, a failed step, or (with the
+    volume constraint on) a volume change above 1 %."""
+    out = []
+    if traj.stats.get("failure"):
+        out.append(traj.stats["failure"])
+    if not np.isfinite(traj.x).all():
+        out.append("positions are not finite (NaN)")
+    if int(traj.inverted.max()) > 0:
+        k = int(np.argmax(traj.inverted > 0))
+        out.append(f"{int(traj.inverted.max())} inverted bricks (first at {traj.time[k] * 1e3:.0f} ms)")
+    vol = float(np.nanmax(np.abs(traj.volume_change)))
+    if volume_constraint and not vol <= VOLUME_LIMIT:
+        out.append(f"tongue volume changed by {100 * vol:.2f} % (limit {100 * VOLUME_LIMIT:g} %)")
+    return out
 
 
 @dataclass
@@ -72,6 +89,7 @@ class SimResult:
     wall: WallSurface
     max_volume_change: float
     up_to_date: bool = False
+    problems: list[str] = field(default_factory=list)  # why the result is not physical (its file is marked invalid)
 
 
 def simulate(schedule: Path | str, duration: float | None = None, dt: float | None = None,
@@ -80,15 +98,15 @@ def simulate(schedule: Path | str, duration: float | None = None, dt: float | No
              tongue_only: bool = False, contact: bool | None = None, force: bool = False) -> SimResult:
     """Run the model under a schedule from its rest posture; write ``out`` (HDF5).  A file that already holds
     this recipe (same mesh content, config sections, schedule, options and code) is left alone."""
-    _positive("--duration", duration)
-    _positive("--dt", dt)
-    sched = load_schedule(schedule)
+    check_number("--duration", duration, gt=0, le=MAX_DURATION_S, unit="s")
+    check_number("--dt", dt, ge=MIN_DT_S, unit="s")
+    cfg = load_config(config)
+    sched = load_schedule(schedule, cfg.muscles.max_force_n)
     if duration is None:
         if sched.duration_ms is None:
             raise ArticError(f"{schedule}: no duration; give --duration S or 'duration_ms' in the schedule")
         duration = units.ms_to_s(sched.duration_ms)
     sched.check_duration(units.s_to_ms(duration), str(schedule))
-    cfg = load_config(config)
     m = mesh_stage.read(mesh, cfg)
     model = build(cfg, m.mesh, m.wall, tongue_only, volume_constraint, contact)
     h = model.options.dt if dt is None else dt
@@ -103,14 +121,17 @@ def simulate(schedule: Path | str, duration: float | None = None, dt: float | No
                               "volume_constraint": model.volume_constraint, "contact": model.contact is not None,
                               "record_every": cfg.simulation.record_every})
     if not force and up_to_date(out, prov):
-        with open_artifact(out, "simulation", STAGE.hint) as f:
+        with open_artifact(out, "simulation", STAGE.hint, allow_invalid=True) as f:
             vol = float(f.attrs["max_abs_volume_change"])
-        return SimResult(out, None, model, m.wall, vol, up_to_date=True)
+            bad = [] if f.attrs.get("valid", True) else str(f.attrs.get("invalid_reason", "")).split("; ")
+        return SimResult(out, None, model, m.wall, vol, up_to_date=True, problems=bad)
     traj = run_simulation(model, sched, duration, h, tongue_only, cfg.simulation.record_every, str(schedule),
                           progress)
+    bad = problems(traj, model.volume_constraint)
     write(out, traj, model, prov, extra={"duration_s": duration, "schedule_yaml": Path(schedule).read_text(),
-                                         "tongue_only": tongue_only})
-    return SimResult(out, traj, model, m.wall, float(np.abs(traj.volume_change).max()))
+                                         "tongue_only": tongue_only, "valid": not bad,
+                                         "invalid_reason": "; ".join(bad)})
+    return SimResult(out, traj, model, m.wall, float(np.nanmax(np.abs(traj.volume_change))), problems=bad)
 
 
 def write(path: Path | str, traj: Trajectory, model: Model, prov: Provenance | None = None,
@@ -125,7 +146,7 @@ def write(path: Path | str, traj: Trajectory, model: Model, prov: Provenance | N
                         "volume_constraint": model.volume_constraint, "wall_time_s": traj.stats["wall_time_s"],
                         "steps": traj.stats["steps"], "factorisations": traj.stats["refactors"],
                         "newton_iterations": traj.stats["newton_iterations"],
-                        "max_abs_volume_change": float(np.abs(traj.volume_change).max())})
+                        "max_abs_volume_change": float(np.nanmax(np.abs(traj.volume_change)))})
         f.create_dataset("time", data=traj.time).attrs["units"] = "s"
         for name, data, unit in [("positions", traj.x, "cm"), ("velocities", traj.v, "cm/s")]:
             f.create_dataset(f"nodes/{name}", data=data, compression="gzip").attrs["units"] = unit
@@ -198,8 +219,9 @@ class Simulation:
         return self.positions_cm[:, self.parts[name]]
 
 
-def read(path: Path | str) -> Simulation:
-    with open_artifact(path, "simulation", STAGE.hint) as f:
+def read(path: Path | str, allow_invalid: bool = False) -> Simulation:
+    """A simulation file; one marked invalid (not physical) is refused unless ``allow_invalid``."""
+    with open_artifact(path, "simulation", STAGE.hint, allow_invalid=allow_invalid) as f:
         try:
             contacts = None
             if "contacts" in f:
