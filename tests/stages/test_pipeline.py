@@ -66,18 +66,21 @@ def test_every_figure_is_a_real_png(built):
         assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 20_000, name
 
 
+def _mtimes(out):
+    return {p: p.stat().st_mtime_ns for p in out.rglob("*") if p.suffix in (".h5", ".json", ".yaml")
+            and ".config" not in p.parts}
+
+
 def test_a_second_run_does_nothing(built):
-    res = make("paper", "CONFIG=configs/ci_thin.yaml", f"OUT={built}", "--question")
-    assert res.returncode == 0, res.stdout + res.stderr  # -q: everything is up to date
+    before = _mtimes(built)
+    res = make("paper", "CONFIG=configs/ci_thin.yaml", f"OUT={built}")
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert "bin/artic" not in res.stdout and "bin/python" not in res.stdout, res.stdout  # no command runs
+    assert _mtimes(built) == before
 
 
 DATA_COMMANDS = ("artic build-mesh", "artic simulate", "artic validate", "artic experiment", "artic ep-map",
                  "artic muscle-function", "artic dynamic-map", "artic solve-target")
-
-
-def _mtimes(out):
-    return {p: p.stat().st_mtime_ns for p in out.rglob("*") if p.suffix in (".h5", ".json", ".yaml")
-            and ".config" not in p.parts}
 
 
 def test_a_plotting_edit_redraws_figures_and_recomputes_nothing(built):
