@@ -200,6 +200,61 @@ class Cuboid(Strict):
     forces_n: list[NonNeg] = [0.1, 0.5, 1.0, 2.0, 3.0, 4.0]
 
 
+class NasalTract(Strict):
+    """The nasal tract behind the velopharyngeal port, from the port to the nostrils.  The default shape is
+    an approximation in the spirit of Dang, Honda & Suzuki (1994, JASA 96: MRI of the nasal tract, about
+    11 cm from the port to the nostrils, widest in the nasal cavity); their measured area functions are not
+    reproduced here."""
+
+    enabled: bool = True
+    port_length_cm: Positive = 0.5  # the port itself: a short tube of the velum's opening area
+    port_from_lips_cm: Positive = 8.5  # for a plain tube: where the port joins it, measured from the lips
+    lengths_cm: Annotated[list[Positive], Field(min_length=1)] = [1.0, 2.0, 2.0, 2.0, 3.0, 1.0]
+    areas_cm2: Annotated[list[Positive], Field(min_length=1)] = [2.0, 3.0, 4.5, 4.0, 2.5, 1.5]
+
+    @field_validator("areas_cm2")
+    @classmethod
+    def _same_length(cls, v, info):
+        if len(v) != len(info.data.get("lengths_cm", v)):
+            raise ValueError("needs one area per length in lengths_cm")
+        return v
+
+
+class PiriformFossa(Strict):
+    """The two piriform fossae: closed side tubes beside the larynx tube (Dang & Honda 1997, JASA 101: about
+    2 cm deep, an antiresonance near 4-5 kHz that also lowers the formants below it)."""
+
+    enabled: bool = True
+    from_glottis_cm: Positive = 2.5  # their entrance, above the glottis
+    length_cm: Positive = 1.9
+    area_cm2: Positive = 1.0  # each
+
+
+class Acoustics(Strict):
+    """Air, walls and losses of the frequency-domain tube model (CGS; Maeda 1982, Ishizaka et al. 1975;
+    ../shared/reference/acoustics.md), each loss switchable."""
+
+    sound_speed_cm_s: Positive = 35000.0
+    air_density_g_cm3: Positive = 1.14e-3
+    air_viscosity_dyn_s_cm2: Positive = 1.86e-4
+    heat_conduction_cal_cm_s_c: Positive = 5.5e-5
+    specific_heat_cal_g_c: Positive = 0.24
+    adiabatic_constant: Annotated[float, Field(gt=1, le=2, allow_inf_nan=False)] = 1.4
+    wall_mass_g_cm2: Positive = 1.5
+    wall_resistance_dyn_s_cm3: Positive = 1600.0
+    wall_stiffness_dyn_cm3: Positive = 3.0e5
+    viscous_losses: bool = True
+    heat_losses: bool = True
+    yielding_walls: bool = True
+    radiation: bool = True  # the lips radiate (parallel R-L); off: an ideal open end
+    velum_area_cm2: NonNeg = 0.0  # the velopharyngeal port's opening; 0: closed
+    max_frequency_hz: Annotated[float, Field(gt=500, le=20000, allow_inf_nan=False)] = 5500.0
+    frequency_step_hz: Annotated[float, Field(gt=0, le=50, allow_inf_nan=False)] = 5.0
+    formants: Annotated[int, Field(ge=1, le=8)] = 5
+    nasal: NasalTract = NasalTract()
+    piriform_fossa: PiriformFossa = PiriformFossa()
+
+
 class Config(Strict):
     schema_version: Literal[1]
     speaker: Speaker
@@ -211,6 +266,7 @@ class Config(Strict):
     cuboid: Cuboid = Cuboid()
     epmap: EPMapSpec = EPMapSpec()
     muscle_function: MuscleFunctionSpec = MuscleFunctionSpec()
+    acoustics: Acoustics = Acoustics()
 
 
 

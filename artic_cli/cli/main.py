@@ -16,6 +16,7 @@ from pathlib import Path
 from types import SimpleNamespace
 from typing import List, Optional
 
+import numpy as np
 import typer
 from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
@@ -568,6 +569,42 @@ def report_cmd(
 
     path = write_report(data, out)
     out_console.print(f"wrote {path}", highlight=False)
+
+
+@app.command("acoustics")
+@handle_errors
+def acoustics_cmd(
+    tube: Path = typer.Option(..., "--tube", help="Tube (CSV): header length_cm,area_cm2, one row per section "
+                                                  "from the glottis to the lips."),
+    config: Optional[Path] = typer.Option(None, "--config", help="Config (its 'acoustics' section: air, walls, "
+                                                                 "losses, branches)."),
+    lossless: bool = typer.Option(False, "--lossless", help="The ideal hard-walled tube: no losses, an ideal "
+                                                            "open end, no side branches."),
+    velum_area: Optional[float] = typer.Option(None, "--velum-area", help="Velopharyngeal port opening, cm^2 "
+                                                                          "(default: the config's, 0 = closed)."),
+    as_json: bool = typer.Option(False, "--json", help="Print formants_hz and bandwidths_hz as JSON."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Write the transfer function and formants (HDF5)."),
+    plot: Optional[Path] = typer.Option(None, "--plot", help="Draw the transfer function with the formants (PNG)."),
+):
+    """Transfer function, radiated spectrum, formants F1-F5 and bandwidths of a tube."""
+    from ..stages.acoustics import tube_acoustics
+
+    r = tube_acoustics(tube, config, lossless, velum_area, out)
+    fm = [None if not np.isfinite(v) else round(float(v), 2) for v in r.formants_hz[0]]
+    bw = [None if not np.isfinite(v) else round(float(v), 2) for v in r.bandwidths_hz[0]]
+    if plot is not None:
+        from ..plots.acoustics import plot_transfer
+
+        plot_transfer(r, 0, plot, title=f"{tube.name}{' (lossless)' if lossless else ''}")
+    if as_json:
+        out_console.print_json(json.dumps({"formants_hz": fm, "bandwidths_hz": bw}))
+        return
+    _print_table(f"formants of {tube}", ("formant", "frequency Hz", "bandwidth Hz"),
+                 [(f"F{k + 1}", "" if f is None else f"{f:.1f}", "" if b is None else f"{b:.1f}")
+                  for k, (f, b) in enumerate(zip(fm, bw))], left=("formant",))
+    for p in (out, plot):
+        if p is not None:
+            out_console.print(f"wrote {p}", highlight=False)
 
 
 def _plot_mesh(mesh: Path, out: Path) -> Path:

@@ -1,0 +1,103 @@
+"""The frequency-domain tube model: chain (ABCD) matrices of lossy cylindrical sections, after Sondhi &
+Schroeter (1987), vectorised over frequencies.
+
+A section of length l and area A at angular frequency w has, per unit length, a series impedance
+Z = R + jw rho/A (R: viscous boundary layer, (S/A^2) sqrt(w rho mu / 2), S = 2 sqrt(pi A) the perimeter)
+and a shunt admittance Y = G + jw A/(rho c^2) + S / (Rw + jw Mw + Kw/(jw)) (G: heat conduction,
+S (eta - 1)/(rho c^2) sqrt(lambda w / (2 cp rho)); the last term: yielding walls, per unit area mass Mw,
+resistance Rw and stiffness Kw).  Its chain matrix is [[cosh gl, Z0 sinh gl], [sinh gl / Z0, cosh gl]] with
+g = sqrt(Z Y), Z0 = sqrt(Z / Y); [P, U] at the glottis side = K [P, U] at the lips side.  A side branch
+(the nasal tract behind the velopharyngeal port, the piriform fossae) is a shunt admittance 1 / Z_in at its
+junction.  The lips radiate into a parallel R-L load (a piston in an infinite baffle, Flanagan 1972):
+R = 128 rho c / (9 pi^2 A), L = 8 rho / (3 pi sqrt(pi A)).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+MIN_AREA_CM2 = 1e-4  # a closure: 0.01 mm^2 keeps the matrices finite (the flow through it is negligible)
+
+
+@dataclass(frozen=True)
+class Air:
+    """Air, walls and which losses act (CGS); see configs/default.yaml, section acoustics."""
+
+    c: float = 35000.0  # speed of sound, cm/s
+    rho: float = 1.14e-3  # density, g/cm^3
+    mu: float = 1.86e-4  # viscosity, dyn s/cm^2
+    kappa: float = 5.5e-5  # heat conduction, cal/(cm s degC)
+    cp: float = 0.24  # specific heat, cal/(g degC)
+    eta: float = 1.4  # adiabatic constant
+    wall_mass: float = 1.5  # g/cm^2
+    wall_resistance: float = 1600.0  # dyn s/cm^3
+    wall_stiffness: float = 3.0e5  # dyn/cm^3
+    viscous: bool = True
+    heat: bool = True
+    walls: bool = True
+    radiation: bool = True  # False: an ideal open end (pressure 0 at the lips)
+
+
+LOSSLESS = Air(viscous=False, heat=False, walls=False, radiation=False)
+
+
+def section_matrices(length_cm: np.ndarray, area_cm2: np.ndarray, w: np.ndarray, air: Air) -> np.ndarray:
+    """(n, F, 2, 2) chain matrices of n sections at angular frequencies ``w`` (F,)."""
+    a = np.maximum(np.asarray(area_cm2, dtype=float), MIN_AREA_CM2)[:, None]
+    ln = np.asarray(length_cm, dtype=float)[:, None]
+    w = np.asarray(w, dtype=float)[None, :]
+    perim = 2.0 * np.sqrt(np.pi * a)
+    z = 1j * w * air.rho / a
+    y = 1j * w * a / (air.rho * air.c ** 2)
+    if air.viscous:
+        z = z + perim / a ** 2 * np.sqrt(w * air.rho * air.mu / 2.0)
+    if air.heat:
+        y = y + perim * (air.eta - 1.0) / (air.rho * air.c ** 2) * np.sqrt(air.kappa * w / (2.0 * air.cp * air.rho))
+    if air.walls:
+        y = y + perim / (air.wall_resistance + 1j * w * air.wall_mass + air.wall_stiffness / (1j * w))
+    g = np.sqrt(z * y) * ln
+    z0 = np.sqrt(z / y)
+    ch, sh = np.cosh(g), np.sinh(g)
+    k = np.empty(g.shape + (2, 2), dtype=complex)
+    k[..., 0, 0] = ch
+    k[..., 0, 1] = z0 * sh
+    k[..., 1, 0] = sh / z0
+    k[..., 1, 1] = ch
+    return k
+
+
+def chain(length_cm: np.ndarray, area_cm2: np.ndarray, w: np.ndarray, air: Air) -> np.ndarray:
+    """(F, 2, 2) product of the sections' matrices, first section first."""
+    k = section_matrices(length_cm, area_cm2, w, air)
+    out = k[0]
+    for m in k[1:]:
+        out = out @ m
+    return out
+
+
+def radiation_impedance(area_cm2: float, w: np.ndarray, air: Air) -> np.ndarray:
+    """(F,) acoustic impedance of an opening of ``area_cm2`` radiating into free space (0: ideal open end)."""
+    if not air.radiation:
+        return np.zeros_like(np.asarray(w, dtype=float), dtype=complex)
+    a = max(float(area_cm2), MIN_AREA_CM2)
+    r = 128.0 * air.rho * air.c / (9.0 * np.pi ** 2 * a)
+    lr = 8.0 * air.rho / (3.0 * np.pi * np.sqrt(np.pi * a))
+    jwl = 1j * np.asarray(w, dtype=float) * lr
+    return jwl * r / (r + jwl)
+
+
+def input_impedance(k: np.ndarray, load: np.ndarray | None) -> np.ndarray:
+    """(F,) impedance looking into a chain ``k`` (F, 2, 2) ended by ``load`` (F,; None: a closed end)."""
+    if load is None:  # U = 0 at the far end: Z = A / C
+        return k[:, 0, 0] / k[:, 1, 0]
+    return (k[:, 0, 0] * load + k[:, 0, 1]) / (k[:, 1, 0] * load + k[:, 1, 1])
+
+
+def shunt(admittance: np.ndarray) -> np.ndarray:
+    """(F, 2, 2) the chain matrix of a side branch of ``admittance`` (F,) at a junction."""
+    s = np.zeros((len(admittance), 2, 2), dtype=complex)
+    s[:, 0, 0] = s[:, 1, 1] = 1.0
+    s[:, 1, 0] = admittance
+    return s

@@ -1,0 +1,83 @@
+"""The volume-velocity transfer function U_lips / U_glottis of a tube with optional side branches, and the
+radiated pressure spectrum.
+
+The glottis is an ideal flow source (the tract's far end seen from the lips: no glottal load); a branch joins
+the tube at its distance from the glottis (a section there is cut in two).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .chain import Air, chain, input_impedance, radiation_impedance, shunt
+from .tube import Tube
+
+
+@dataclass(frozen=True)
+class Branch:
+    """A side tube from a junction ``at_cm`` above the glottis: sections from the junction outward, ending
+    closed (the piriform fossae) or radiating through its last area (the nostrils); ``count`` alike."""
+
+    at_cm: float
+    tube: Tube
+    radiating: bool = False
+    count: int = 1
+
+
+@dataclass
+class Tract:
+    tube: Tube
+    branches: list[Branch] = field(default_factory=list)
+
+
+def _branch_admittance(b: Branch, w: np.ndarray, air: Air) -> np.ndarray:
+    k = chain(b.tube.length_cm, b.tube.area_cm2, w, air)
+    load = radiation_impedance(b.tube.area_cm2[-1], w, air) if b.radiating else None
+    return b.count / input_impedance(k, load)
+
+
+def split_at(tube: Tube, points_cm) -> Tube:
+    """The same tube with section boundaries at ``points_cm`` from the glottis (a section is cut in two)."""
+    lengths, areas = list(tube.length_cm), list(tube.area_cm2)
+    for p in sorted(points_cm):
+        edges = np.concatenate([[0.0], np.cumsum(lengths)])
+        k = int(np.searchsorted(edges, p)) - 1
+        if 0 <= k < len(lengths) and 1e-9 < p - edges[k] < lengths[k] - 1e-9:
+            first = p - edges[k]
+            lengths[k:k + 1] = [first, lengths[k] - first]
+            areas[k:k + 1] = [areas[k], areas[k]]
+    return Tube(np.array(lengths), np.array(areas))
+
+
+def tract_chain(tract: Tract, w: np.ndarray, air: Air) -> np.ndarray:
+    """(F, 2, 2) glottis-to-lips chain matrix with the branches' shunts."""
+    t = split_at(tract.tube, [b.at_cm for b in tract.branches])
+    edges = np.concatenate([[0.0], np.cumsum(t.length_cm)])
+    cut = sorted((int(np.argmin(np.abs(edges - b.at_cm))), j) for j, b in enumerate(tract.branches))
+    total = None
+    start = 0
+    for idx, j in cut + [(len(t.length_cm), None)]:
+        if idx > start:
+            k = chain(t.length_cm[start:idx], t.area_cm2[start:idx], w, air)
+            total = k if total is None else total @ k
+            start = idx
+        if j is not None:
+            s = shunt(_branch_admittance(tract.branches[j], w, air))
+            total = s if total is None else total @ s
+    return total
+
+
+def transfer(tract: Tract, f_hz: np.ndarray, air: Air) -> np.ndarray:
+    """(F,) complex U_lips / U_glottis at ``f_hz``."""
+    w = 2.0 * np.pi * np.maximum(np.asarray(f_hz, dtype=float), 1e-3)
+    k = tract_chain(tract, w, air)
+    z_lips = radiation_impedance(tract.tube.area_cm2[-1], w, air)
+    return 1.0 / (k[:, 1, 0] * z_lips + k[:, 1, 1])
+
+
+def radiated_pressure(h: np.ndarray, f_hz: np.ndarray, air: Air, distance_cm: float = 100.0) -> np.ndarray:
+    """(F,) far-field pressure per unit glottal flow: j w rho H / (4 pi r) (a simple source at the lips)."""
+    w = 2.0 * np.pi * np.asarray(f_hz, dtype=float)
+    return 1j * w * air.rho * h / (4.0 * np.pi * distance_cm)

@@ -1,0 +1,97 @@
+"""Stage ``acoustics``: transfer function, radiated spectrum, formants and bandwidths of a tube (section
+II.A's vocal tract as an area function; the vocal-tract stage will feed it frame by frame)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..acoustics.formants import formants
+from ..acoustics.model import air_of, frequencies, tract_of
+from ..acoustics.transfer import radiated_pressure, transfer
+from ..acoustics.tube import Tube, read_tube_csv
+from ..config import Config, load_config
+from ..errors import ArticError
+from ..io.fingerprint import digest
+from ..io.store import atomic_h5, open_artifact
+from ..validation import check_number
+from .base import Stage, up_to_date
+
+STAGE = Stage(name="acoustics", module=__name__, sections=("acoustics",), kind="acoustics",
+              hint="rerun 'artic acoustics'")
+
+
+@dataclass
+class Acoustics:
+    """Frames x frequencies: the transfer function U_lips / U_glottis and the radiated pressure (dB), and
+    frames x formants: their frequencies and -3 dB bandwidths (Hz; NaN where there are fewer peaks)."""
+
+    frequency_hz: np.ndarray  # (F,)
+    transfer_db: np.ndarray  # (T, F)
+    pressure_db: np.ndarray  # (T, F)
+    formants_hz: np.ndarray  # (T, K)
+    bandwidths_hz: np.ndarray  # (T, K)
+    time_s: np.ndarray | None = None  # (T,) for a time series
+
+
+def compute(tubes: list[Tube], cfg: Config, lossless: bool = False, velum_area_cm2: float | None = None) -> Acoustics:
+    ac = STAGE.view(cfg).acoustics
+    air = air_of(ac, lossless)
+    f = frequencies(ac)
+    tf, pr, fm, bw = [], [], [], []
+    for tube in tubes:
+        tract = tract_of(tube, ac, velum_area_cm2, lossless)
+        h = transfer(tract, f, air)
+        tf.append(20 * np.log10(np.maximum(np.abs(h), 1e-12)))
+        pr.append(20 * np.log10(np.maximum(np.abs(radiated_pressure(h, f, air)), 1e-30) / 2e-4))
+        fk, bk = formants(lambda x, t=tract: np.abs(transfer(t, x, air)), ac.max_frequency_hz,
+                          ac.frequency_step_hz, ac.formants, lossless=lossless)
+        fm.append(fk)
+        bw.append(bk)
+    return Acoustics(f, np.array(tf), np.array(pr), np.array(fm), np.array(bw))
+
+
+def write(path: Path | str, result: Acoustics, prov=None, extra: dict | None = None) -> None:
+    with atomic_h5(path, STAGE.kind, prov) as f:
+        f.attrs.update(extra or {})
+        f.attrs["layout"] = "frames x frequencies (transfer_db, pressure_db), frames x formants (formants_hz, bandwidths_hz)"
+        for name, data, unit in (("frequency_hz", result.frequency_hz, "Hz"),
+                                 ("transfer_db", result.transfer_db, "dB re 1 (U_lips / U_glottis)"),
+                                 ("pressure_db", result.pressure_db, "dB re 20 uPa at 1 m per cm^3/s of glottal flow"),
+                                 ("formants_hz", result.formants_hz, "Hz"), ("bandwidths_hz", result.bandwidths_hz, "Hz")):
+            f.create_dataset(name, data=data).attrs["units"] = unit
+        if result.time_s is not None:
+            f.create_dataset("time_s", data=result.time_s).attrs["units"] = "s"
+
+
+def read(path: Path | str) -> Acoustics:
+    with open_artifact(path, STAGE.kind, STAGE.hint) as f:
+        try:
+            return Acoustics(frequency_hz=f["frequency_hz"][()], transfer_db=f["transfer_db"][()],
+                             pressure_db=f["pressure_db"][()], formants_hz=f["formants_hz"][()],
+                             bandwidths_hz=f["bandwidths_hz"][()],
+                             time_s=f["time_s"][()] if "time_s" in f else None)
+        except (KeyError, ValueError, OSError) as err:
+            raise ArticError(f"{path} is damaged or incomplete ({type(err).__name__}); {STAGE.hint}") from None
+
+
+def tube_acoustics(tube: Path | str, config: Path | str | None = None, lossless: bool = False,
+                   velum_area_cm2: float | None = None, out: Path | str | None = None) -> Acoustics:
+    """The acoustics of a tube file; with ``out``, written there (left alone when it holds this recipe)."""
+    check_number("--velum-area", velum_area_cm2, ge=0, le=10, unit="cm^2")
+    cfg = load_config(config)
+    t = read_tube_csv(tube)
+    if out is not None:
+        out = Path(out)
+        if not out.parent.is_dir():
+            raise ArticError(f"--out {out}: the folder {out.parent} does not exist; create it or give another path")
+        prov = STAGE.provenance(cfg, inputs={"tube": digest({"l": t.length_cm, "a": t.area_cm2})},
+                                params={"lossless": lossless, "velum_area_cm2": velum_area_cm2})
+        if up_to_date(out, prov):
+            return read(out)
+    result = compute([t], cfg, lossless, velum_area_cm2)
+    if out is not None:
+        write(out, result, prov, {"source": str(tube), "lossless": lossless})
+    return result
