@@ -31,8 +31,10 @@ def tract_of(tube: Tube, ac, velum_area_cm2: float | None = None, lossless: bool
         return Tract(tube, branches)
     pf = ac.piriform_fossa
     if pf.enabled and tube.total_length_cm > pf.from_glottis_cm:
-        branches.append(Branch(pf.from_glottis_cm, Tube(np.array([pf.length_cm]), np.array([pf.area_cm2])),
-                               radiating=False, count=2))
+        n = pf.sections
+        top = 2.0 * pf.volume_cm3 / pf.length_cm  # the area at the entrance: a linear taper to zero holds the volume
+        area = top * (1.0 - (np.arange(n) + 0.5) / n)
+        branches.append(Branch(pf.from_glottis_cm, Tube(np.full(n, pf.length_cm / n), area), radiating=False))
     velum = ac.velum_area_cm2 if velum_area_cm2 is None else velum_area_cm2
     nt = ac.nasal
     if nt.enabled and velum > 0:
