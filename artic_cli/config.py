@@ -233,6 +233,17 @@ class PiriformFossa(Strict):
     sections: Annotated[int, Field(ge=1, le=40)] = 5
 
 
+class Synthesis(Strict):
+    """The time-domain synthesizer (:mod:`artic_cli.acoustics.synthesis`) and its LF source."""
+
+    sample_rate_hz: Annotated[int, Field(ge=8000, le=96000)] = 44100
+    glottal_reflection: Annotated[float, Field(ge=0, lt=1, allow_inf_nan=False)] = 0.97
+    section_loss: Annotated[float, Field(ge=0, lt=0.05, allow_inf_nan=False)] = 5e-4  # per section and sample
+    lf_tp: Annotated[float, Field(gt=0.1, lt=0.8)] = 0.42  # LF timing, fractions of a period: flow peak
+    lf_te: Annotated[float, Field(gt=0.2, lt=0.95)] = 0.56  # main excitation
+    lf_ta: Annotated[float, Field(gt=0, lt=0.1)] = 0.012  # return phase
+
+
 class Acoustics(Strict):
     """Air, walls and losses of the frequency-domain tube model (CGS; Maeda 1982, Ishizaka et al. 1975;
     ../shared/reference/acoustics.md), each loss switchable."""
@@ -260,6 +271,7 @@ class Acoustics(Strict):
     formants: Annotated[int, Field(ge=1, le=8)] = 5
     nasal: NasalTract = NasalTract()
     piriform_fossa: PiriformFossa = PiriformFossa()
+    synthesis: Synthesis = Synthesis()
 
 
 class Config(Strict):

@@ -43,8 +43,8 @@ class Air:
 LOSSLESS = Air(viscous=False, heat=False, walls=False, radiation=False)
 
 
-def section_matrices(length_cm: np.ndarray, area_cm2: np.ndarray, w: np.ndarray, air: Air) -> np.ndarray:
-    """(n, F, 2, 2) chain matrices of n sections at angular frequencies ``w`` (F,)."""
+def _line_parameters(length_cm: np.ndarray, area_cm2: np.ndarray, w: np.ndarray, air: Air):
+    """(n, F) cosh(g l), Z0 sinh(g l), sinh(g l) / Z0 of n sections at angular frequencies ``w`` (F,)."""
     a = np.maximum(np.asarray(area_cm2, dtype=float), MIN_AREA_CM2)[:, None]
     ln = np.asarray(length_cm, dtype=float)[:, None]
     w = np.asarray(w, dtype=float)[None, :]
@@ -59,21 +59,33 @@ def section_matrices(length_cm: np.ndarray, area_cm2: np.ndarray, w: np.ndarray,
         y = y + perim / (air.wall_resistance + 1j * w * air.wall_mass + air.wall_stiffness / (1j * w))
     g = np.sqrt(z * y) * ln
     z0 = np.sqrt(z / y)
-    ch, sh = np.cosh(g), np.sinh(g)
-    k = np.empty(g.shape + (2, 2), dtype=complex)
+    e = np.exp(g)
+    ei = 1.0 / e
+    ch, sh = 0.5 * (e + ei), 0.5 * (e - ei)
+    return ch, z0 * sh, sh / z0
+
+
+def section_matrices(length_cm: np.ndarray, area_cm2: np.ndarray, w: np.ndarray, air: Air) -> np.ndarray:
+    """(n, F, 2, 2) chain matrices of n sections at angular frequencies ``w`` (F,)."""
+    ch, b, c = _line_parameters(length_cm, area_cm2, w, air)
+    k = np.empty(ch.shape + (2, 2), dtype=complex)
     k[..., 0, 0] = ch
-    k[..., 0, 1] = z0 * sh
-    k[..., 1, 0] = sh / z0
+    k[..., 0, 1] = b
+    k[..., 1, 0] = c
     k[..., 1, 1] = ch
     return k
 
 
 def chain(length_cm: np.ndarray, area_cm2: np.ndarray, w: np.ndarray, air: Air) -> np.ndarray:
-    """(F, 2, 2) product of the sections' matrices, first section first."""
-    k = section_matrices(length_cm, area_cm2, w, air)
-    out = k[0]
-    for m in k[1:]:
-        out = out @ m
+    """(F, 2, 2) product of the sections' matrices, first section first (the four entries multiplied as
+    arrays over frequencies: no per-frequency 2x2 products)."""
+    ch, bb, cc = _line_parameters(length_cm, area_cm2, w, air)
+    a, b, c, d = ch[0], bb[0], cc[0], ch[0]
+    for k in range(1, ch.shape[0]):
+        x, y, z = ch[k], bb[k], cc[k]
+        a, b, c, d = a * x + b * z, a * y + b * x, c * x + d * z, c * y + d * x
+    out = np.empty(a.shape + (2, 2), dtype=complex)
+    out[:, 0, 0], out[:, 0, 1], out[:, 1, 0], out[:, 1, 1] = a, b, c, d
     return out
 
 

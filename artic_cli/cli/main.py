@@ -607,6 +607,25 @@ def acoustics_cmd(
             out_console.print(f"wrote {p}", highlight=False)
 
 
+@app.command("synthesize")
+@handle_errors
+def synthesize_cmd(
+    tube: Path = typer.Option(..., "--tube", help="Tube (CSV): header length_cm,area_cm2, glottis first."),
+    out: Path = typer.Option(..., "--out", help="Sound to write (WAV, 16-bit PCM)."),
+    duration: float = typer.Option(1.0, "--duration", help="How long the tube is held and voiced, s."),
+    f0: float = typer.Option(110.0, "--f0", help="Fundamental frequency, Hz (50-500)."),
+    f0_contour: Optional[Path] = typer.Option(None, "--f0-contour", help="F0 over time instead (CSV: "
+                                                                          "time_s,f0_hz)."),
+    config: Optional[Path] = typer.Option(None, "--config", help="Config (its 'acoustics.synthesis' section)."),
+):
+    """Voice a tube with the LF source through a reflection-type line; write a WAV file."""
+    from ..stages.synthesize import synthesize_tube
+
+    a = synthesize_tube(tube, out, duration, f0, f0_contour, config)
+    out_console.print(f"wrote {out}: {len(a.samples) / a.sample_rate_hz:.2f} s at {a.sample_rate_hz} Hz, 16-bit PCM",
+                      highlight=False)
+
+
 def _plot_mesh(mesh: Path, out: Path) -> Path:
     from ..plots.mesh import plot_mesh
     from ..stages.mesh import read

@@ -1,0 +1,58 @@
+"""Acoustics speed: one transfer function (1024 frequencies, 44 sections) and formant tracks of 200 frames;
+VocalTractLab's transfer function side by side where it is installed.  Goals (issue 14): 5 ms and 1 s."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from artic_cli.acoustics.formants import formants
+from artic_cli.acoustics.model import air_of, tract_of
+from artic_cli.acoustics.transfer import transfer
+from artic_cli.acoustics.tube import Tube
+from artic_cli.config import load_config
+
+
+def _median(fn, n=7):
+    times = []
+    for _ in range(n):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return float(np.median(times))
+
+
+def main() -> None:
+    ac = load_config().acoustics
+    air = air_of(ac)
+    rng = np.random.default_rng(14)
+    tubes = [Tube(np.full(44, 17.5 / 44), np.clip(3 + 2 * np.sin(np.linspace(0, 3, 44) + p), 0.3, None))
+             for p in rng.uniform(0, 6, 200)]
+    f = np.linspace(ac.max_frequency_hz / 1024, ac.max_frequency_hz, 1024)
+    tract = tract_of(tubes[0], ac)
+    one = _median(lambda: transfer(tract, f, air))
+    print(f"one transfer function, 1024 frequencies, 44 sections + piriform fossa: {one * 1e3:.2f} ms "
+          f"(goal <= 5 ms: {'met' if one <= 0.005 else 'NOT met'})")
+
+    def tracks():
+        for t in tubes:
+            tr = tract_of(t, ac)
+            formants(lambda x, tr=tr: np.abs(transfer(tr, x, air)), ac.max_frequency_hz, ac.frequency_step_hz)
+
+    tr_time = _median(tracks, n=3)
+    print(f"formant tracks (F1-F5 with bandwidths), 200 frames: {tr_time:.2f} s "
+          f"(goal <= 1 s: {'met' if tr_time <= 1.0 else 'NOT met'})")
+    try:
+        import vocaltractlab_cython as vtl
+    except ImportError:
+        print("VocalTractLab not installed (pip install vocaltractlab-cython): no side-by-side figure")
+        return
+    shape = vtl.get_shape("a", "tract")
+    theirs = _median(lambda: vtl.tract_state_to_transfer_function(shape, n_spectrum_samples=2048))
+    print(f"VocalTractLab, one transfer function (its default, 2048-point spectrum): {theirs * 1e3:.2f} ms; "
+          f"ours / theirs = {one / theirs:.2f}")
+
+
+if __name__ == "__main__":
+    main()

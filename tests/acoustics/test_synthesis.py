@@ -1,0 +1,96 @@
+"""Sound from tubes: the LF source, the reflection-type line, the WAV file, and Praat's view of it."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.io import wavfile
+from typer.testing import CliRunner
+
+from artic_cli.acoustics.formants import formants
+from artic_cli.acoustics.model import air_of
+from artic_cli.acoustics.source import lf_flow_derivative
+from artic_cli.acoustics.synthesis import resample_tube, synthesize
+from artic_cli.acoustics.transfer import Tract, transfer
+from artic_cli.acoustics.tube import from_pieces
+from artic_cli.cli.main import app
+from artic_cli.config import load_config
+
+VOWELS = {"a": ((9, 1), (8, 7)), "i": ((9, 8), (6, 1)), "u": ((5, 6), (3, 1.5), (6, 8), (2, 0.6))}
+
+
+def _csv(tmp_path, pieces):
+    p = tmp_path / "t.csv"
+    p.write_text("length_cm,area_cm2\n" + "".join(f"{ln},{a}\n" for ln, a in pieces))
+    return p
+
+
+def test_the_lf_source_has_zero_net_flow_and_its_peak_excitation_at_te():
+    fs, f0 = 88200, 100.0
+    d = lf_flow_derivative(np.full(fs // 10, f0), fs)
+    assert abs(d.sum() / fs) < 1e-5 and abs(d.min() + 1) < 0.01
+    period = int(fs / f0)
+    assert abs(np.argmin(d[:period]) / period - 0.56) < 0.01
+
+
+def test_a_closure_stays_stable_and_silent_behind_it():
+    fs = 88200
+    open_ = resample_tube(np.array([17.5]), np.array([4.0]), 44)
+    shut = open_.copy()
+    shut[30:33] = 0.0
+    src = lf_flow_derivative(np.full(fs // 5, 110.0), fs)
+    y_open = synthesize(open_[None], np.array([0.0]), src, fs)
+    y_shut = synthesize(shut[None], np.array([0.0]), src, fs)
+    assert np.isfinite(y_shut).all() and np.abs(y_shut).max() < 0.01 * np.abs(y_open).max()
+    frames = np.array([shut, shut, open_])  # closed, then released at 0.1 s
+    y = synthesize(frames, np.array([0.0, 0.1, 0.12]), src, fs)
+    assert np.isfinite(y).all()
+    assert np.abs(y[: int(0.09 * fs)]).max() < 0.01 * np.abs(y[int(0.15 * fs):]).max()
+
+
+@pytest.mark.parametrize("vowel", sorted(VOWELS))
+def test_praat_measures_our_transfer_function_formants_in_the_sound(vowel, tmp_path):
+    parselmouth = pytest.importorskip("parselmouth")
+    t = _csv(tmp_path, VOWELS[vowel])
+    res = CliRunner().invoke(app, ["synthesize", "--tube", str(t), "--out", str(tmp_path / "v.wav"),
+                                   "--duration", "0.6", "--f0", "115"])
+    assert res.exit_code == 0, res.output
+    rate, pcm = wavfile.read(tmp_path / "v.wav")
+    assert rate == 44100 and pcm.dtype == np.int16 and abs(len(pcm) / rate - 0.6) < 0.01
+    ac = load_config().acoustics
+    air = air_of(ac)
+    tract = Tract(from_pieces(*VOWELS[vowel]))
+    ours, _ = formants(lambda f: np.abs(transfer(tract, f, air)))
+    fm = parselmouth.Sound(str(tmp_path / "v.wav")).to_formant_burg(0.01, 5, 5000, 0.025, 50)
+    times = np.linspace(0.2, 0.4, 9)
+    for k, tol in ((0, 0.10), (1, 0.05)):  # Burg may insert spurious peaks: take the one nearest ours
+        found = [np.nanmedian([fm.get_value_at_time(j, x) for x in times]) for j in range(1, 6)]
+        nearest = min(found, key=lambda v: abs(v - ours[k]))
+        assert abs(nearest / ours[k] - 1) < tol, (vowel, k + 1, nearest, ours[k], found)
+
+
+@pytest.mark.parametrize("args, needle", [
+    (["--duration", "0"], "--duration must be greater than 0"),
+    (["--duration", "nan"], "finite"),
+    (["--f0", "10"], "--f0 must be at least 50"),
+    (["--f0", "-3"], "--f0 must be at least 50"),
+])
+def test_bad_synthesis_options_are_one_line_and_write_nothing(tmp_path, args, needle):
+    t = _csv(tmp_path, VOWELS["a"])
+    res = CliRunner().invoke(app, ["synthesize", "--tube", str(t), "--out", str(tmp_path / "v.wav"), *args])
+    assert res.exit_code == 2 and needle in res.output, res.output
+    assert not (tmp_path / "v.wav").exists()
+    res = CliRunner().invoke(app, ["synthesize", "--tube", str(t), "--out", str(tmp_path / "no" / "v.wav")])
+    assert res.exit_code == 2 and "does not exist" in res.output
+
+
+def test_an_f0_contour_file_is_checked(tmp_path):
+    t = _csv(tmp_path, VOWELS["a"])
+    (tmp_path / "f0.csv").write_text("time_s,f0_hz\n0,120\n0.3,600\n")
+    res = CliRunner().invoke(app, ["synthesize", "--tube", str(t), "--out", str(tmp_path / "v.wav"), "--duration",
+                                   "0.3", "--f0-contour", str(tmp_path / "f0.csv")])
+    assert res.exit_code == 2 and "line 3: key 'f0_hz'" in res.output and not (tmp_path / "v.wav").exists()
+    (tmp_path / "f0.csv").write_text("time_s,f0_hz\n0,120\n0.3,90\n")
+    res = CliRunner().invoke(app, ["synthesize", "--tube", str(t), "--out", str(tmp_path / "v.wav"), "--duration",
+                                   "0.3", "--f0-contour", str(tmp_path / "f0.csv")])
+    assert res.exit_code == 0 and (tmp_path / "v.wav").is_file()
