@@ -131,3 +131,32 @@ def check_name(name: str, source: str, key: str = "name") -> str:
         return _safe_name(name)
     except ValueError as err:
         raise ArticError(f"{source}: key '{key}': {err}; rename it") from None
+
+
+def read_csv(path, columns: list[str], record: type[BaseModel], what: str, hint: str) -> list:
+    """A CSV file of numbers with exactly ``columns`` as its header, each row checked as a ``record``; any
+    problem is one ArticError naming the file, the line, the key and ``hint``."""
+    import csv
+    import io
+    from pathlib import Path
+
+    path = Path(path)
+    if not path.is_file():
+        raise ArticError(f"{what} not found: {path}; {hint}")
+    try:
+        reader = csv.DictReader(io.StringIO(path.read_text()))
+        header = [h.strip() for h in (reader.fieldnames or [])]
+        records = list(reader)
+    except (UnicodeDecodeError, csv.Error):
+        raise ArticError(f"{path} is not a readable CSV file; {hint}") from None
+    if header != columns:
+        raise ArticError(f"{path}: the header must be '{','.join(columns)}', got {','.join(header) or 'nothing'}; "
+                         f"{hint}")
+    rows = []
+    for k, r in enumerate(records, start=2):
+        try:
+            values = {key.strip(): float(v) for key, v in r.items()}
+        except (TypeError, ValueError, AttributeError):
+            raise ArticError(f"{path}, line {k}: every value must be a number, got {dict(r)}; {hint}") from None
+        rows.append(parse(record, values, f"{path}, line {k}", f"{what} row", hint))
+    return rows

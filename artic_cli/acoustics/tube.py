@@ -2,14 +2,13 @@
 
 from __future__ import annotations
 
-import csv
-import io
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+
 from ..errors import ArticError
-from ..validation import AreaCm2, LengthCm, Strict, parse
+from ..validation import AreaCm2, LengthCm, Strict, read_csv
 
 
 @dataclass(frozen=True)
@@ -43,25 +42,8 @@ class _Row(Strict):
 
 def read_tube_csv(path: Path | str) -> Tube:
     """A tube file: header ``length_cm,area_cm2``, one row per section from the glottis to the lips."""
-    path = Path(path)
     hint = "give a CSV with header length_cm,area_cm2 and one row per section, glottis first"
-    if not path.is_file():
-        raise ArticError(f"tube file not found: {path}; {hint}")
-    try:
-        reader = csv.DictReader(io.StringIO(path.read_text()))
-        header = reader.fieldnames or []
-        records = list(reader)
-    except (UnicodeDecodeError, csv.Error):
-        raise ArticError(f"{path} is not a readable CSV file; {hint}") from None
-    if [h.strip() for h in header] != ["length_cm", "area_cm2"]:
-        raise ArticError(f"{path}: the header must be 'length_cm,area_cm2', got {','.join(header) or 'nothing'}; {hint}")
-    rows = []
-    for k, r in enumerate(records, start=2):
-        try:
-            values = {key.strip(): float(v) for key, v in r.items()}
-        except (TypeError, ValueError, AttributeError):
-            raise ArticError(f"{path}, line {k}: every value must be a number, got {dict(r)}; {hint}") from None
-        rows.append(parse(_Row, values, f"{path}, line {k}", "tube row", hint))
+    rows = read_csv(path, ["length_cm", "area_cm2"], _Row, "tube file", hint)
     if len(rows) < 2:
         raise ArticError(f"{path}: a tube needs at least two sections, got {len(rows)}; {hint}")
     return Tube(np.array([r.length_cm for r in rows]), np.array([r.area_cm2 for r in rows]))

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import csv
-import io
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -17,7 +15,7 @@ from ..acoustics.tube import Tube, read_tube_csv
 from ..config import Config, load_config
 from ..errors import ArticError
 from ..io.store import atomic_path
-from ..validation import F0Hz, NonNegative, Strict, check_number, parse
+from ..validation import F0Hz, NonNegative, Strict, check_number, read_csv
 from .base import Stage
 
 STAGE = Stage(name="synthesize", module=__name__, sections=("acoustics",), kind="audio",
@@ -71,21 +69,8 @@ class F0Point(Strict):
 
 def read_f0_contour(path: Path | str) -> list[tuple[float, float]]:
     """A CSV ``time_s,f0_hz`` (times ascending, F0 50-500 Hz)."""
-    path = Path(path)
     hint = "give a CSV with header time_s,f0_hz, times ascending, F0 50-500 Hz"
-    if not path.is_file():
-        raise ArticError(f"F0 contour not found: {path}; {hint}")
-    reader = csv.DictReader(io.StringIO(path.read_text()))
-    if [h.strip() for h in (reader.fieldnames or [])] != ["time_s", "f0_hz"]:
-        raise ArticError(f"{path}: the header must be 'time_s,f0_hz'; {hint}")
-    out = []
-    for k, r in enumerate(reader, start=2):
-        try:
-            row = {key.strip(): float(v) for key, v in r.items()}
-        except (TypeError, ValueError, AttributeError):
-            raise ArticError(f"{path}, line {k}: every value must be a number; {hint}") from None
-        p = parse(F0Point, row, f"{path}, line {k}", "F0 point", hint)
-        out.append((p.time_s, p.f0_hz))
+    out = [(p.time_s, p.f0_hz) for p in read_csv(path, ["time_s", "f0_hz"], F0Point, "F0 contour", hint)]
     if not out or any(b[0] <= a[0] for a, b in zip(out, out[1:])):
         raise ArticError(f"{path}: needs at least one point and ascending times; {hint}")
     return out
