@@ -39,15 +39,8 @@ def lf_flow_derivative(f0_hz: np.ndarray, fs: float, tp: float = 0.42, te: float
     alpha, eps = _lf_shape(tp, te, ta)
     wg = math.pi / tp
     e0 = -1.0 / (math.exp(alpha * te) * math.sin(wg * te))
-    out = np.empty(len(f0_hz))
-    phase = 0.0
-    for k, f0 in enumerate(f0_hz):
-        t = phase
-        if t <= te:
-            out[k] = e0 * math.exp(alpha * t) * math.sin(wg * t)
-        else:
-            out[k] = -(1.0 / (eps * ta)) * (math.exp(-eps * (t - te)) - math.exp(-eps * (1.0 - te)))
-        phase += f0 / fs
-        if phase >= 1.0:
-            phase -= 1.0
-    return out
+    # the phase within the current period, each sample advancing by its own F0 / fs
+    phase = np.concatenate([[0.0], np.cumsum(np.asarray(f0_hz, dtype=float) / fs)[:-1]]) % 1.0
+    opening = e0 * np.exp(alpha * phase) * np.sin(wg * phase)
+    closing = -(1.0 / (eps * ta)) * (np.exp(-eps * (phase - te)) - math.exp(-eps * (1.0 - te)))
+    return np.where(phase <= te, opening, closing)

@@ -16,6 +16,7 @@ is the time derivative of the lips' volume velocity, brought to the audio rate b
 from __future__ import annotations
 
 import numpy as np
+from scipy.signal import lfilter
 
 from ..mechanics.kernels import njit
 
@@ -91,10 +92,6 @@ def synthesize(frame_areas: np.ndarray, frame_times_s: np.ndarray, source: np.nd
     t = np.arange(len(source)) / fs_internal
     index = np.interp(t, frame_times_s, np.arange(len(frame_times_s))) if len(frame_times_s) > 1 else np.zeros(len(t))
     # the source drives flow: integrate its derivative (leaky, so no drift) before it enters the line
-    flow = np.empty_like(source)
-    acc = 0.0
-    for k, d in enumerate(source):
-        acc = 0.999 * acc + d / fs_internal
-        flow[k] = acc
+    flow = lfilter([1.0 / fs_internal], [1.0, -0.999], source)
     return _line(np.ascontiguousarray(frame_areas, dtype=float), index.astype(float), flow * 1e4,
                  glottal_reflection, rho, c, float(fs_internal), section_loss)
