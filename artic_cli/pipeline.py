@@ -56,19 +56,7 @@ def load_pipeline(path: Path | str) -> Pipeline:
 def _files(*modules: str, plots: bool = False) -> list[str]:
     """Source files of ``modules`` and what they import; for a plot module, the plotting modules it imports
     (what it draws from is the figure rule's input artefacts, whose own rules follow the physics)."""
-    if plots:
-        from .io import fingerprint
-
-        seen, todo = set(), list(modules)
-        while todo:
-            m = todo.pop()
-            if m in seen or not m.startswith("artic_cli.plots"):
-                continue
-            seen.add(m)
-            todo.extend(fingerprint._imports(m) - seen)
-        names = sorted(seen)
-    else:
-        names = module_closure(*modules)
+    names = module_closure(*modules, within="artic_cli.plots" if plots else None)
     return [str(module_path(m).relative_to(ROOT)) for m in names]
 
 

@@ -133,14 +133,17 @@ def _imports(name: str) -> set[str]:
     return {m for m in out if _exists(m)}
 
 
-def module_closure(*roots: str) -> list[str]:
+def module_closure(*roots: str, within: str | None = None) -> list[str]:
     """``roots`` and every artic_cli module they import, transitively; plots and the CLI are not followed, and
-    neither are a package ``__init__``'s own imports (they only re-export)."""
+    neither are a package ``__init__``'s own imports (they only re-export).  ``within``: follow only modules
+    of that package instead (e.g. ``artic_cli.plots`` for what a plot module draws with)."""
     seen: set[str] = set()
     todo = [r for r in roots]
     while todo:
         name = todo.pop()
-        if name in seen or any(name == p or name.startswith(p + ".") for p in NOT_RESULTS):
+        skip = (not name.startswith(within)) if within else any(name == p or name.startswith(p + ".")
+                                                                 for p in NOT_RESULTS)
+        if name in seen or skip:
             continue
         seen.add(name)
         if module_path(name).name != "__init__.py" or name in roots:
