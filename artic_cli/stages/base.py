@@ -30,8 +30,10 @@ class Stage:
         return ConfigView(cfg, self.sections)
 
     def provenance(self, cfg: Config | None, inputs: dict | None = None, params: dict | None = None,
-                   code_roots: tuple[str, ...] = ()) -> Provenance:
-        return Provenance(stage=self.name, sections_sha256=sections_hash(cfg, self.sections) if cfg else "",
+                   code_roots: tuple[str, ...] = (), sections: tuple[str, ...] | None = None) -> Provenance:
+        """The recipe of a run; ``sections``: the part of the declared sections this run reads, if less."""
+        used = self.sections if sections is None else sections
+        return Provenance(stage=self.name, sections_sha256=sections_hash(cfg, used) if cfg else "",
                           inputs=dict(inputs or {}), code_sha256=code_hash(self.module, *code_roots),
                           params=dict(params or {}))
 

@@ -16,7 +16,7 @@ from .. import units
 from ..config import Config, load_config
 from ..errors import ArticError
 from ..geometry.wall import WallSurface
-from ..io.fingerprint import digest, sections_hash
+from ..io.fingerprint import digest
 from ..io.store import Provenance, atomic_h5, open_artifact
 from ..validation import check_number
 from ..mechanics.loads import load_program
@@ -114,12 +114,11 @@ def simulate(schedule: Path | str, duration: float | None = None, dt: float | No
         raise ArticError(f"--dt {h:g} s is longer than the run ({duration:g} s); give a smaller --dt")
     out = Path(out) if out is not None else Path("data/sims") / f"{Path(schedule).stem}.h5"
     sections = TONGUE_SECTIONS if tongue_only else ARTICULATOR_SECTIONS
-    prov = Provenance(stage=STAGE.name, sections_sha256=sections_hash(cfg, sections),
-                      inputs={"mesh": m.content_sha256, "schedule": digest(sched.model_dump(mode="json"))},
-                      code_sha256=STAGE.provenance(None).code_sha256,
-                      params={"duration_s": duration, "dt_s": h, "tongue_only": tongue_only,
-                              "volume_constraint": model.volume_constraint, "contact": model.contact is not None,
-                              "record_every": cfg.simulation.record_every})
+    prov = STAGE.provenance(cfg, sections=sections,
+                            inputs={"mesh": m.content_sha256, "schedule": digest(sched.model_dump(mode="json"))},
+                            params={"duration_s": duration, "dt_s": h, "tongue_only": tongue_only,
+                                    "volume_constraint": model.volume_constraint, "contact": model.contact is not None,
+                                    "record_every": cfg.simulation.record_every})
     if not force and up_to_date(out, prov):
         with open_artifact(out, "simulation", STAGE.hint, allow_invalid=True) as f:
             vol = float(f.attrs["max_abs_volume_change"])
