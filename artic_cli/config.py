@@ -274,6 +274,66 @@ class Acoustics(Strict):
     synthesis: Synthesis = Synthesis()
 
 
+class AreaRegion(Strict):
+    """One region of the distance-to-area law A = alpha d^beta (cm^2 from cm)."""
+
+    name: str
+    until_cm: Positive  # the region ends this far from the glottis along the grid's spine
+    alpha: Positive
+    beta: Annotated[float, Field(gt=0, le=4, allow_inf_nan=False)]
+
+
+class LipControl(Strict):
+    """The lip tube: a control input like a muscle force (its length and aperture area)."""
+
+    length_cm: Annotated[float, Field(gt=0, le=3, allow_inf_nan=False)] = 1.0
+    area_cm2: Annotated[float, Field(ge=0, le=10, allow_inf_nan=False)] = 3.0
+
+
+class TractGrid(Strict):
+    """Grid lines normal to a fixed reference midline (the spine, glottis to incisors) in the midsagittal
+    plane; on each line the distance between the inner contour (larynx front, epiglottis, tongue, lower
+    incisor) and the outer one (pharyngeal wall, velum, palate, upper incisor)."""
+
+    spine_cm: Annotated[list[Point2], Field(min_length=3)]
+    spacing_cm: Annotated[float, Field(ge=0.05, le=1.0, allow_inf_nan=False)] = 0.3
+    reach_cm: Annotated[float, Field(gt=0.5, le=6.0, allow_inf_nan=False)] = 3.0  # each side of the spine
+    smoothing_cm: NonNeg = 0.6  # the spine is smoothed over this arc length before the normals are taken
+    penetration_cm: Positive = 0.3  # tongue beyond the wall by up to this reads as a closure, not a miss
+
+
+class VocalTract(Strict):
+    """The speaker's vocal tract beyond the tongue mesh and the contact wall (midsagittal, cm; the speaker
+    frame): what the area function needs (the paper's section II.A: tongue, lips, teeth, hard palate,
+    velum, pharyngeal wall, larynx).  The velum is the part of the wall's midsagittal palate behind
+    ``hard_palate_end_x_cm``; the lower incisor and the lower lip move with the mandible; the larynx is
+    fixed in the head frame (the model has no thyroid or cricoid to carry it)."""
+
+    hard_palate_end_x_cm: Finite = -5.2
+    velum_nasal_surface_cm: Outline  # the velum's posterior surface, hard palate end to the uvula (drawn)
+    velum_port_cm2: NonNeg = 0.0  # the velopharyngeal port's default opening (a control input; 0: closed)
+    velum_port_line_cm: Annotated[list[Point2], Field(min_length=2, max_length=2)]  # the oral tract's top behind the velum
+    pharynx_lower_cm: Outline  # the posterior wall below the contact wall's pharynx, down to the glottis
+    larynx_front_cm: Outline  # glottis front, the laryngeal vestibule, the epiglottis to its tip
+    upper_incisor_cm: Outline  # labial surface down to the incisor edge
+    lower_incisor_cm: Outline  # edge down the labial surface (with the mandible)
+    upper_lip_cm: Outline
+    lower_lip_cm: Outline  # with the mandible
+    lips: LipControl = LipControl()
+    lip_sections: Annotated[int, Field(ge=1, le=10)] = 2
+    grid: TractGrid
+    area_law_source: str = ""
+    area_law: Annotated[list[AreaRegion], Field(min_length=1)]
+
+    @field_validator("area_law")
+    @classmethod
+    def _ascending(cls, v):
+        ends = [r.until_cm for r in v]
+        if ends != sorted(ends) or len(set(ends)) != len(ends):
+            raise ValueError("regions must be listed from the glottis with rising until_cm")
+        return v
+
+
 class Config(Strict):
     schema_version: Literal[1]
     speaker: Speaker
@@ -286,6 +346,7 @@ class Config(Strict):
     epmap: EPMapSpec = EPMapSpec()
     muscle_function: MuscleFunctionSpec = MuscleFunctionSpec()
     acoustics: Acoustics = Acoustics()
+    vocal_tract: VocalTract | None = None  # the speaker's tract (required by 'artic vocal-tract')
 
 
 

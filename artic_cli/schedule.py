@@ -13,6 +13,14 @@ Example::
         force_n: [0, 2.0, 0]  # total force in N, shared equally by the set's nodes
         onset_ms: 0
         duration_ms: 300
+    tract:                    # the lip tube and the velopharyngeal port (read by 'artic vocal-tract')
+      - at_ms: 100            # from here the values move to these ...
+        ramp_ms: 60           # ... along a raised cosine over this time
+        lip_area_cm2: 0.4
+        lip_length_cm: 1.5
+        velum_port_cm2: 0.0
+
+The mechanics ignore ``tract``: a change there leaves every simulation up to date.
 """
 
 from __future__ import annotations
@@ -20,11 +28,13 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Annotated
 
+import numpy as np
 from pydantic import Field, ValidationInfo, field_validator
 
 from .config import read_yaml
 from .errors import ArticError
-from .validation import DEFAULT_MAX_FORCE_N, DurationMs, ForceN, LoadN, OnsetMs, Strict, parse
+from .validation import (DEFAULT_MAX_FORCE_N, AreaCm2, DurationMs, ForceN, LoadN, NonNegative, OnsetMs, Strict,
+                         parse)
 
 
 class LoadEntry(Strict):
@@ -51,10 +61,50 @@ class MuscleEntry(Strict):
     duration_ms: DurationMs
 
 
+class TractEntry(Strict):
+    """From ``at_ms`` the given tract controls move to their new values over ``ramp_ms`` (raised cosine)."""
+
+    at_ms: OnsetMs
+    ramp_ms: NonNegative = 50.0
+    lip_area_cm2: AreaCm2 | None = None
+    lip_length_cm: Annotated[float, Field(gt=0, le=3, allow_inf_nan=False)] | None = None
+    velum_port_cm2: AreaCm2 | None = None
+
+
+TRACT_CONTROLS = ("lip_area_cm2", "lip_length_cm", "velum_port_cm2")
+
+
+def tract_controls(entries: list[TractEntry], start: dict[str, float], time_s) -> dict[str, np.ndarray]:
+    """Each tract control at ``time_s`` (s): ``start`` values, then each entry's ramp from the value
+    reached so far to its own (a smooth time course, like a muscle force's)."""
+    t_ms = np.asarray(time_s, dtype=float) * 1e3
+    out = {}
+    for name in TRACT_CONTROLS:
+        value = np.full_like(t_ms, float(start[name]))
+        for e in sorted(entries, key=lambda e: e.at_ms):
+            target = getattr(e, name)
+            if target is None:
+                continue
+            before = float(np.interp(e.at_ms, t_ms, value)) if len(t_ms) else float(start[name])
+            if e.ramp_ms > 0:
+                u = np.clip((t_ms - e.at_ms) / e.ramp_ms, 0.0, 1.0)
+                w = 0.5 - 0.5 * np.cos(np.pi * u)
+            else:
+                w = (t_ms >= e.at_ms).astype(float)
+            value = np.where(t_ms >= e.at_ms, before + (target - before) * w, value)
+        out[name] = value
+    return out
+
+
 class Schedule(Strict):
     duration_ms: DurationMs | None = None
     muscles: list[MuscleEntry] = []
     loads: list[LoadEntry] = []
+    tract: list[TractEntry] = []
+
+    def mechanics_digest_data(self) -> dict:
+        """What the mechanics read (the tract controls left out)."""
+        return self.model_dump(mode="json", exclude={"tract"})
 
     def check_duration(self, duration_ms: float, source: str = "schedule") -> None:
         for kind, entries in (("loads", self.loads), ("muscles", self.muscles)):
@@ -91,4 +141,5 @@ def load_schedule(path: Path | str, max_force_n: float = DEFAULT_MAX_FORCE_N) ->
     return parse_schedule(read_yaml(path, "schedule"), str(path), max_force_n)
 
 
-__all__ = ["Schedule", "LoadEntry", "MuscleEntry", "load_schedule", "parse_schedule"]
+__all__ = ["Schedule", "LoadEntry", "MuscleEntry", "TractEntry", "TRACT_CONTROLS", "load_schedule", "parse_schedule",
+           "tract_controls"]

@@ -607,6 +607,56 @@ def acoustics_cmd(
             out_console.print(f"wrote {p}", highlight=False)
 
 
+@app.command("vocal-tract")
+@handle_errors
+def vocal_tract_cmd(
+    sim: Optional[Path] = typer.Option(None, "--sim", help="Simulation (HDF5): the tract of every frame."),
+    rest: bool = typer.Option(False, "--rest", help="The rest posture (the articulator settled under gravity)."),
+    ep: Optional[str] = typer.Option(None, "--ep", help="One EP of the maps, JAW:MUSCLE=N[,MUSCLE=N] "
+                                                        "(e.g. JO_0.5:SG=2.5)."),
+    epmaps: Path = typer.Option(Path("data/epmaps.h5"), "--epmaps", help="EP maps (HDF5), for --ep."),
+    mesh: Path = typer.Option(Path("data/mesh.h5"), "--mesh", help="Mesh (HDF5) the shapes were made on."),
+    config: Optional[Path] = typer.Option(None, "--config", help="Config (its 'vocal_tract' section)."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Tracts to write (HDF5; default data/tracts/NAME.h5)."),
+    csv: Optional[Path] = typer.Option(None, "--csv", help="Also write one frame as a tube (CSV: length_cm,area_cm2)."),
+    frame: Optional[int] = typer.Option(None, "--frame", help="The frame for --csv and --plot (default: the last)."),
+    plot: Optional[Path] = typer.Option(None, "--plot", help="Draw the midsagittal tract with its grid beside the "
+                                                             "area function (PNG)."),
+    animate: Optional[Path] = typer.Option(None, "--animate", help="Animate a simulation's tracts (GIF)."),
+    lip_area: Optional[float] = typer.Option(None, "--lip-area", help="Lip aperture area, cm^2 (default: the "
+                                                                      "config's; a schedule's tract entries follow)."),
+    lip_length: Optional[float] = typer.Option(None, "--lip-length", help="Lip tube length, cm."),
+    velum_port: Optional[float] = typer.Option(None, "--velum-port", help="Velopharyngeal port area, cm^2 (0 = closed)."),
+    force: bool = typer.Option(False, "--force", help="Recompute even if the file is up to date."),
+):
+    """Area functions (glottis to lips) from simulated shapes: midline, grid, distances, areas."""
+    from ..stages.vocal_tract import pick_frame, vocal_tract, write_csv
+
+    if animate is not None and sim is None:
+        raise ArticError("--animate needs a simulation (--sim FILE); a single shape has nothing to animate")
+    r = vocal_tract(sim, rest, ep, epmaps, mesh, config, out, lip_area, lip_length, velum_port, force)
+    t = r.tracts
+    k = pick_frame(t, frame)
+    area, pos, reg = t.af.constriction()
+    _print_table(f"vocal tract ({t.n_frames} frame{'s' if t.n_frames > 1 else ''})",
+                 ("frame", "time s", "length cm", "min area cm^2", "at cm", "region"),
+                 [(str(j), f"{t.time_s[j]:.3f}", f"{t.af.tract_length_cm[j]:.2f}", f"{area[j]:.3f}", f"{pos[j]:.2f}",
+                   t.af.region_names[int(reg[j])]) for j in sorted({0, k, t.n_frames - 1})], left=("region",))
+    written = [r.path]
+    if csv is not None:
+        written.append(write_csv(csv, t, k))
+    if plot is not None:
+        from ..plots.vocal_tract import plot_tract
+
+        written.append(plot_tract(t, k, plot))
+    if animate is not None:
+        from ..plots.vocal_tract import animate_tracts
+
+        written.append(animate_tracts(t, animate))
+    for p in written:
+        out_console.print(f"{'up to date' if p == r.path and r.up_to_date else 'wrote'} {p}", highlight=False)
+
+
 @app.command("synthesize")
 @handle_errors
 def synthesize_cmd(

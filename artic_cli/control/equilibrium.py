@@ -62,13 +62,20 @@ def jaw_rest(model: Model, jaw_forces: dict[str, float]) -> State:
     return State(t=0.0, x=state.x, v=np.zeros_like(state.v), sigma2=state.sigma2, fibre_strain=state.fibre_strain)
 
 
+def equilibrium_state(model: Model, start: State, forces_n: dict[str, float], spec: EPMapSpec,
+                      fast: bool = False) -> tuple[State, EP]:
+    """Hold the forces for ``spec.duration_ms`` (``fast``: stop once settled): the whole final state and the
+    EP read from it."""
+    h = hold(model, start, control_for(model, forces_n), units.ms_to_s(spec.duration_ms), watch_nodes(model),
+             units.ms_to_s(spec.convergence_window_ms), stop_below=spec.early_stop_tol_cm if fast else None)
+    return h.state, EP(x=h.state.x[watch_nodes(model)].copy(), drift_cm=h.drift,
+                       converged=bool(h.drift < spec.convergence_tol_cm), stopped_ms=units.s_to_ms(h.stopped))
+
+
 def equilibrium_point(model: Model, start: State, forces_n: dict[str, float], spec: EPMapSpec,
                       fast: bool = False) -> EP:
     """Hold the forces for ``spec.duration_ms`` (``fast``: stop once settled) and read the control points."""
-    h = hold(model, start, control_for(model, forces_n), units.ms_to_s(spec.duration_ms), watch_nodes(model),
-             units.ms_to_s(spec.convergence_window_ms), stop_below=spec.early_stop_tol_cm if fast else None)
-    return EP(x=h.state.x[watch_nodes(model)].copy(), drift_cm=h.drift,
-              converged=bool(h.drift < spec.convergence_tol_cm), stopped_ms=units.s_to_ms(h.stopped))
+    return equilibrium_state(model, start, forces_n, spec, fast)[1]
 
 
 # --- workers (top level: they travel to loky / dask processes) --------------------------------------

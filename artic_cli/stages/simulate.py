@@ -115,7 +115,7 @@ def simulate(schedule: Path | str, duration: float | None = None, dt: float | No
     out = Path(out) if out is not None else Path("data/sims") / f"{Path(schedule).stem}.h5"
     sections = TONGUE_SECTIONS if tongue_only else ARTICULATOR_SECTIONS
     prov = STAGE.provenance(cfg, sections=sections,
-                            inputs={"mesh": m.content_sha256, "schedule": digest(sched.model_dump(mode="json"))},
+                            inputs={"mesh": m.content_sha256, "schedule": digest(sched.mechanics_digest_data())},
                             params={"duration_s": duration, "dt_s": h, "tongue_only": tongue_only,
                                     "volume_constraint": model.volume_constraint, "contact": model.contact is not None,
                                     "record_every": cfg.simulation.record_every})
@@ -149,6 +149,7 @@ def write(path: Path | str, traj: Trajectory, model: Model, prov: Provenance | N
         f.create_dataset("time", data=traj.time).attrs["units"] = "s"
         for name, data, unit in [("positions", traj.x, "cm"), ("velocities", traj.v, "cm/s")]:
             f.create_dataset(f"nodes/{name}", data=data, compression="gzip").attrs["units"] = unit
+        f.create_dataset("nodes/rest", data=model.rest, compression="gzip").attrs["units"] = "cm (the model's rest, before gravity)"
         for part, idx in node_parts(model).items():
             f.create_dataset(f"nodes/parts/{part}", data=idx).attrs["units"] = "node indices"
         for name, idx in model.control_points().items():
@@ -202,6 +203,7 @@ class Simulation:
 
     time_s: np.ndarray
     positions_cm: np.ndarray  # (T, N, 3)
+    rest_cm: np.ndarray | None  # (N, 3) the model's rest (the frame bones' motions are measured from)
     velocities_cm_s: np.ndarray
     parts: dict[str, np.ndarray]  # part -> node indices
     control_points: dict[str, np.ndarray]  # name -> (T, 3) cm
@@ -232,7 +234,8 @@ def read(path: Path | str, allow_invalid: bool = False) -> Simulation:
                                     force_n=[force[a:b] for a, b in zip(off[:-1], off[1:])])
             m = f.get("muscles")
             return Simulation(
-                time_s=f["time"][()], positions_cm=f["nodes/positions"][()], velocities_cm_s=f["nodes/velocities"][()],
+                time_s=f["time"][()], positions_cm=f["nodes/positions"][()],
+                rest_cm=f["nodes/rest"][()] if "nodes/rest" in f else None, velocities_cm_s=f["nodes/velocities"][()],
                 parts={k: v[()] for k, v in f["nodes/parts"].items()},
                 control_points={k: g["position"][()] for k, g in f["control_points"].items()},
                 volume_change=f["volume_change"][()], inverted_bricks=f["inverted_bricks"][()],

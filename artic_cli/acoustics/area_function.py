@@ -1,0 +1,124 @@
+"""Area functions from midsagittal contours: distances along the grid lines, areas by power laws.
+
+On each grid line the tract is the stretch between the inner contour's last crossing and the outer wall's
+first crossing (s measured from the spine toward the wall); a tongue beyond the wall (contact) reads
+distance 0, a closure.  The area is A = alpha d^beta with one (alpha, beta) per region (Heinz & Stevens
+1965; the regions' coefficients are the config's).  Each grid line is one section, as long as half the
+midline's distance to its neighbours on each side, so the section lengths add up to the midline's length;
+the lip tube (a control: length and area) follows as the last sections.  Everything is vectorised over
+frames: contours (F, S, 2, 2) as segments.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..geometry.tract import Grid
+
+_EPS = 1e-12
+
+
+def segments(polylines) -> np.ndarray:
+    """(S, 2, 2): every segment of the polylines, as (start, end) points."""
+    return np.concatenate([np.stack([p[:-1], p[1:]], axis=1) for p in polylines if len(p) > 1])
+
+
+def crossings(grid: Grid, segs: np.ndarray) -> np.ndarray:
+    """s (cm) where each grid line crosses each segment, NaN where it does not: (F, L, S) for segments
+    (F, S, 2, 2)."""
+    a = segs[:, :, 0, :]
+    e = segs[:, :, 1, :] - a
+    o, n = grid.origin[None, :, None, :], grid.normal[None, :, None, :]
+    ao = a[:, None] - o  # (F, L, S, 2)
+    e = e[:, None]
+    den = n[..., 0] * e[..., 1] - n[..., 1] * e[..., 0]
+    ok = np.abs(den) > _EPS
+    den = np.where(ok, den, 1.0)
+    s = (ao[..., 0] * e[..., 1] - ao[..., 1] * e[..., 0]) / den
+    u = (ao[..., 0] * n[..., 1] - ao[..., 1] * n[..., 0]) / den
+    hit = ok & (u >= 0.0) & (u <= 1.0) & (np.abs(s) <= grid.reach_cm)
+    return np.where(hit, s, np.nan)
+
+
+def wall_distance(grid: Grid, outer: np.ndarray) -> np.ndarray:
+    """s of the outer wall's first crossing on the wall side of each line, (L,); NaN where the line misses
+    the wall."""
+    s = crossings(grid, outer[None])[0]
+    s = np.where(s > 0.0, s, np.inf)
+    first = s.min(axis=1)
+    return np.where(np.isfinite(first), first, np.nan)
+
+
+def inner_distance(grid: Grid, inner: np.ndarray, wall_s: np.ndarray, penetration_cm: float) -> np.ndarray:
+    """s of the inner contour's last crossing below the wall (up to ``penetration_cm`` beyond it), (F, L);
+    NaN where the line meets no inner contour."""
+    s = crossings(grid, inner)
+    s = np.where(s < wall_s[None, :, None] + penetration_cm, s, np.nan)
+    with np.errstate(all="ignore"):
+        last = np.nanmax(np.where(np.isnan(s), -np.inf, s), axis=2)
+    return np.where(np.isfinite(last), last, np.nan)
+
+
+def power_law(distance_cm: np.ndarray, alpha: np.ndarray, beta: np.ndarray) -> np.ndarray:
+    """A = alpha d^beta (cm^2), 0 for d <= 0."""
+    d = np.maximum(distance_cm, 0.0)
+    return alpha * d ** beta
+
+
+def section_lengths(midline: np.ndarray) -> np.ndarray:
+    """(F, L) lengths: half the distance to each neighbour along the midline (F, L, 2); they sum to the
+    midline's length."""
+    seg = np.linalg.norm(np.diff(midline, axis=1), axis=2)  # (F, L-1)
+    pad = np.zeros((len(midline), 1))
+    return 0.5 * (np.concatenate([pad, seg], axis=1) + np.concatenate([seg, pad], axis=1))
+
+
+@dataclass(frozen=True)
+class AreaFunctions:
+    """Area functions of F frames: N = grid lines + lip sections, glottis first (cm, cm^2)."""
+
+    length_cm: np.ndarray  # (F, N)
+    area_cm2: np.ndarray  # (F, N)
+    region: np.ndarray  # (N,) region index; the lip tube's sections are len(names) - 1
+    region_names: tuple[str, ...]
+    distance_cm: np.ndarray  # (F, L) inner-to-wall distance on each line
+    inner_s_cm: np.ndarray  # (F, L)
+    wall_s_cm: np.ndarray  # (L,)
+    midline_cm: np.ndarray  # (F, L, 2)
+
+    @property
+    def tract_length_cm(self) -> np.ndarray:
+        return self.length_cm.sum(axis=1)
+
+    def constriction(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Per frame: the smallest area (cm^2), its section's centre from the glottis (cm), its region index."""
+        k = np.argmin(self.area_cm2, axis=1)
+        rows = np.arange(len(k))
+        centre = np.cumsum(self.length_cm, axis=1) - 0.5 * self.length_cm
+        return self.area_cm2[rows, k], centre[rows, k], self.region[k]
+
+
+def area_functions(grid: Grid, inner: np.ndarray, outer: np.ndarray, alpha: np.ndarray, beta: np.ndarray,
+                   region_names: tuple[str, ...], lip_length_cm: np.ndarray, lip_area_cm2: np.ndarray,
+                   lip_sections: int, penetration_cm: float) -> AreaFunctions:
+    """From inner contours (F, S, 2, 2), the fixed outer contour (S', 2, 2), the law's per-region
+    coefficients and the lip controls (F,) to the area functions.  Lines that miss a contour give NaN
+    distances (the caller says which)."""
+    wall_s = wall_distance(grid, outer)
+    inner_s = inner_distance(grid, inner, wall_s, penetration_cm)
+    d = np.maximum(wall_s[None, :] - inner_s, 0.0)
+    mid_s = np.minimum(0.5 * (inner_s + wall_s[None, :]), wall_s[None, :])
+    midline = grid.origin[None] + mid_s[..., None] * grid.normal[None]
+    area = power_law(d, alpha[grid.region][None, :], beta[grid.region][None, :])
+    length = section_lengths(midline)
+    f = len(inner)
+    lip_len = np.repeat((np.asarray(lip_length_cm, float) / lip_sections)[:, None], lip_sections, axis=1)
+    lip_area = np.repeat(np.asarray(lip_area_cm2, float)[:, None], lip_sections, axis=1)
+    names = tuple(region_names) + ("lips",)
+    region = np.concatenate([grid.region, np.full(lip_sections, len(names) - 1)])
+    return AreaFunctions(length_cm=np.concatenate([length, lip_len.reshape(f, -1)], axis=1),
+                         area_cm2=np.concatenate([area, lip_area.reshape(f, -1)], axis=1), region=region,
+                         region_names=names, distance_cm=d, inner_s_cm=inner_s, wall_s_cm=wall_s,
+                         midline_cm=midline)
