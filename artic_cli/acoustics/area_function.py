@@ -53,12 +53,14 @@ def wall_distance(grid: Grid, outer: np.ndarray) -> np.ndarray:
 
 def inner_distance(grid: Grid, inner: np.ndarray, wall_s: np.ndarray, penetration_cm: float) -> np.ndarray:
     """s of the inner contour's last crossing below the wall (up to ``penetration_cm`` beyond it), (F, L);
-    NaN where the line meets no inner contour."""
+    +inf where the line crosses the inner contour only farther beyond the wall (the tongue is through it: a
+    closure); NaN where the line meets no inner contour at all."""
     s = crossings(grid, inner)
-    s = np.where(s < wall_s[None, :, None] + penetration_cm, s, np.nan)
+    below = np.where(s < wall_s[None, :, None] + penetration_cm, s, np.nan)
     with np.errstate(all="ignore"):
-        last = np.nanmax(np.where(np.isnan(s), -np.inf, s), axis=2)
-    return np.where(np.isfinite(last), last, np.nan)
+        last = np.nanmax(np.where(np.isnan(below), -np.inf, below), axis=2)
+    beyond = np.isfinite(s).any(axis=2)
+    return np.where(np.isfinite(last), last, np.where(beyond, np.inf, np.nan))
 
 
 def power_law(distance_cm: np.ndarray, alpha: np.ndarray, beta: np.ndarray) -> np.ndarray:
@@ -108,8 +110,9 @@ def area_functions(grid: Grid, inner: np.ndarray, outer: np.ndarray, alpha: np.n
     distances (the caller says which)."""
     wall_s = wall_distance(grid, outer)
     inner_s = inner_distance(grid, inner, wall_s, penetration_cm)
-    d = np.maximum(wall_s[None, :] - inner_s, 0.0)
-    mid_s = np.minimum(0.5 * (inner_s + wall_s[None, :]), wall_s[None, :])
+    with np.errstate(invalid="ignore"):
+        d = np.maximum(wall_s[None, :] - inner_s, 0.0)
+    mid_s = np.minimum(0.5 * (np.minimum(inner_s, wall_s[None, :]) + wall_s[None, :]), wall_s[None, :])
     midline = grid.origin[None] + mid_s[..., None] * grid.normal[None]
     area = power_law(d, alpha[grid.region][None, :], beta[grid.region][None, :])
     length = section_lengths(midline)

@@ -139,7 +139,7 @@ def build_mesh_cmd(
 
     s = build_mesh(config, out)
     if plot:
-        _plot_mesh(out, plot)
+        _plot_mesh(out, plot, config)
     rel = abs(s.cylinder_volume_cm3 - s.volume_cm3) / s.volume_cm3
     verb = f"{s.path} is up to date (same speaker geometry and code)" if s.up_to_date else f"wrote {s.path}"
     out_console.print(f"{verb}: {s.nodes} nodes, {s.bricks} bricks, {s.cylinders} cylinders, "
@@ -363,6 +363,27 @@ def plot_muscle_function_cmd(
     for point, path in (("tip", tip), ("dorsum", dorsum)):
         if path is not None:
             out_console.print(f"wrote {plot_muscle_function(mf, point, path)}", highlight=False)
+
+
+@plot_app.command("vocal-tract")
+@handle_errors
+def plot_vocal_tract_cmd(
+    tracts: Path = typer.Argument(..., help="Result of 'artic vocal-tract'."),
+    out: Optional[Path] = typer.Option(None, "--out", help="The midsagittal tract beside its area function (PNG)."),
+    frame: Optional[int] = typer.Option(None, "--frame", help="The frame to draw (default: the last)."),
+    animate: Optional[Path] = typer.Option(None, "--animate", help="Every frame (GIF)."),
+):
+    """The midsagittal tract with its grid lines beside the area function; or an animation."""
+    from ..plots.vocal_tract import animate_tracts, plot_tract
+    from ..stages.vocal_tract import pick_frame, read
+
+    if out is None and animate is None:
+        raise ArticError("nothing to draw; give --out PNG and/or --animate GIF")
+    t = read(tracts)
+    if out is not None:
+        out_console.print(f"wrote {plot_tract(t, pick_frame(t, frame), out)}", highlight=False)
+    if animate is not None:
+        out_console.print(f"wrote {animate_tracts(t, animate)}", highlight=False)
 
 
 @app.command("dynamic-map")
@@ -634,7 +655,7 @@ def vocal_tract_cmd(
 
     if animate is not None and sim is None:
         raise ArticError("--animate needs a simulation (--sim FILE); a single shape has nothing to animate")
-    r = vocal_tract(sim, rest, ep, epmaps, mesh, config, out, lip_area, lip_length, velum_port, force)
+    r = vocal_tract(sim, rest, ep, epmaps, mesh, config, out, lip_area, lip_length, velum_port, force, frame)
     t = r.tracts
     k = pick_frame(t, frame)
     area, pos, reg = t.af.constriction()
@@ -676,12 +697,19 @@ def synthesize_cmd(
                       highlight=False)
 
 
-def _plot_mesh(mesh: Path, out: Path) -> Path:
+def _plot_mesh(mesh: Path, out: Path, config: Path | None = None) -> Path:
+    from ..config import load_config
+    from ..geometry.tract import outline
     from ..plots.mesh import plot_mesh
     from ..stages.mesh import read
 
-    m = read(mesh)
-    return plot_mesh(m.mesh, m.wall, m.speaker.landmarks_cm, out)
+    cfg = load_config(config)
+    m = read(mesh, cfg)
+    tract = None
+    if cfg.vocal_tract is not None:
+        surface = m.mesh.nodes[m.mesh.node_sets["midsagittal_surface"], :2]
+        tract = outline(cfg.vocal_tract, cfg.speaker.wall, surface, (np.eye(3), np.zeros(3))).drawn
+    return plot_mesh(m.mesh, m.wall, m.speaker.landmarks_cm, out, tract=tract)
 
 
 def _plot_simulation(sim: Path, model, wall, plot: Path | None, animate: Path | None) -> None:
@@ -713,9 +741,10 @@ def _plot_fig7(doc: dict, out: Path) -> Path:
 def plot_mesh_cmd(
     mesh: Path = typer.Option(Path("data/mesh.h5"), "--mesh", help="Mesh artefact from build-mesh."),
     out: Path = typer.Option(Path("reports/fig1_mesh.png"), "--out", help="Picture to write (PNG)."),
+    config: Optional[Path] = typer.Option(None, "--config", help="Config of the mesh (its vocal tract is drawn too)."),
 ):
-    """Fig. 1: the mesh, the wall and the muscles' landmarks, midsagittal and lateral."""
-    out_console.print(f"wrote {_plot_mesh(mesh, out)}", highlight=False)
+    """Fig. 1: the mesh, the wall, the vocal tract's other parts and the muscles' landmarks."""
+    out_console.print(f"wrote {_plot_mesh(mesh, out, config)}", highlight=False)
 
 
 @plot_app.command("simulation")

@@ -14,7 +14,7 @@ from ..errors import ArticError
 from ..io.store import open_artifact, write_text_atomic
 from .base import Stage
 
-STAGE = Stage(name="report", module=__name__, sections=(), reads=("mesh", "cuboid", "sims", "experiments", "musclefunction", "epmaps", "dynamic", "solve"), kind="report", hint="rerun 'artic report' (or 'make paper')")
+STAGE = Stage(name="report", module=__name__, sections=(), reads=("mesh", "cuboid", "sims", "tracts", "experiments", "musclefunction", "epmaps", "dynamic", "solve"), kind="report", hint="rerun 'artic report' (or 'make paper')")
 
 
 @dataclass
@@ -268,12 +268,42 @@ def articulator_section(data: Path) -> tuple[list[Row], list[str]]:
         "![SG 4 N + JO 3 N held for 300 ms](art_sg_jo.png)", ""]
 
 
+def tract_section(data: Path) -> tuple[list[Row], list[str]]:
+    """The rest tract and the tracts of the articulator's simulations."""
+    from . import vocal_tract as vt
+
+    rest = vt.read(data / "tracts" / "rest.h5")
+    area, pos, reg = rest.af.constriction()
+    length = float(rest.af.tract_length_cm[0])
+    grid_area = rest.af.area_cm2[0, :rest.grid.n_lines]
+    n_lip = len(rest.af.region) - rest.grid.n_lines
+    rows = [Row("rest tract length, glottis to lips", "adult male, about 17 cm (16.5-18)",
+                f"{length:.2f} cm ({rest.grid.n_lines} grid sections + {n_lip} lip sections)",
+                _verdict(16.5 <= length <= 18.0, "16.5-18 cm")),
+            Row("rest tract: smallest area (grid)", "open vowel [e]: no constriction",
+                f"{grid_area.min():.2f} cm^2 at {pos[0]:.1f} cm ({rest.af.region_names[int(reg[0])]})",
+                _verdict(grid_area.min() >= 0.15, "at least 0.15 cm^2"))]
+    lines = ["![The rest tract: midsagittal view, grid and area function](tract_rest.png)", ""]
+    for path in sorted((data / "tracts").glob("*.h5")):
+        if path.stem == "rest":
+            continue
+        t = vt.read(path)
+        a, p, r = t.af.constriction()
+        k = int(np.argmin(a))
+        sane = bool(np.isfinite(t.af.area_cm2).all() and (t.af.area_cm2 >= 0).all())
+        rows.append(Row(f"{path.stem}: the narrowest frame of {t.n_frames}", "areas finite, >= 0, one per frame",
+                        f"{a[k]:.3f} cm^2 at {p[k]:.1f} cm ({t.af.region_names[int(r[k])]}), "
+                        f"t = {t.time_s[k] * 1e3:.0f} ms", _verdict(sane, "finite and >= 0")))
+        lines.append(f"![{path.stem}: the last frame's tract](tract_{path.stem}.png)")
+    return rows, lines + [""]
+
+
 def map_section(data: Path) -> tuple[list[Row], list[str]]:
     rows, extra = map_rows(data)
     return rows, extra + [""]
 
 
-SECTIONS = {"tissue": tissue_section, "articulator": articulator_section, "function": function_rows,
+SECTIONS = {"tissue": tissue_section, "articulator": articulator_section, "tract": tract_section, "function": function_rows,
             "maps": map_section}
 
 

@@ -190,9 +190,9 @@ def write_csv(path: Path | str, t: Tracts, frame: int) -> Path:
     return Path(path)
 
 
-def pick_frame(t: Tracts, frame: int | None) -> int:
-    """``frame`` (negative counts from the end; None: the last), checked against the file."""
-    n = t.n_frames
+def pick_frame(t: Tracts | int, frame: int | None) -> int:
+    """``frame`` (negative counts from the end; None: the last), checked against the tracts (or a count)."""
+    n = t if isinstance(t, int) else t.n_frames
     k = n - 1 if frame is None else int(frame)
     if not -n <= k < n:
         raise ArticError(f"--frame {frame} is out of range: the tracts have {n} frames (0 to {n - 1}); give one of them")
@@ -280,9 +280,10 @@ def vocal_tract(sim: Path | str | None = None, rest: bool = False, ep: str | Non
                 epmaps: Path | str = "data/epmaps.h5", mesh: Path | str = "data/mesh.h5",
                 config: Path | str | None = None, out: Path | str | None = None,
                 lip_area: float | None = None, lip_length: float | None = None, velum_port: float | None = None,
-                force: bool = False) -> TractResult:
+                force: bool = False, frame: int | None = None) -> TractResult:
     """The tracts of a simulation's frames (``sim``), of the rest posture (``rest``) or of one EP (``ep``);
-    written to ``out`` (HDF5).  A file that already holds this recipe is read back, not recomputed."""
+    written to ``out`` (HDF5).  A file that already holds this recipe is read back, not recomputed.
+    ``frame``: the frame the caller will use, checked before anything is written."""
     if sum(x is not None and x is not False for x in (sim, ep)) + bool(rest) != 1:
         raise ArticError("give exactly one of --sim FILE, --rest or --ep JAW:MUSCLE=N")
     overrides = check_overrides(lip_area, lip_length, velum_port)
@@ -316,7 +317,13 @@ def vocal_tract(sim: Path | str | None = None, rest: bool = False, ep: str | Non
         prov = STAGE.provenance(cfg, params=dict(params, ep=ep), inputs={"mesh": m.content_sha256, "epmaps":
                                                                         str(maps.attrs.get("content_sha256", ""))})
     if not force and up_to_date(out, prov):
-        return TractResult(Path(out), read(out), up_to_date=True)
+        done = read(out)
+        pick_frame(done, frame)
+        return TractResult(Path(out), done, up_to_date=True)
+    if sim is not None:
+        pick_frame(len(s.time_s), frame)
+    else:
+        pick_frame(1, frame)
     extra = {}
     if sim is not None:
         shapes = shapes_of_simulation(s, m.mesh)

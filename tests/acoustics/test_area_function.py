@@ -1,0 +1,70 @@
+"""Area functions from contours: distances on grid lines, power laws, section lengths, closures."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from artic_cli.acoustics.area_function import area_functions, segments
+from artic_cli.config import AreaRegion
+from artic_cli.geometry.tract import tract_grid
+from artic_cli.schedule import TractEntry, tract_controls
+
+
+def _channel_tract(cfg, regions, spine=((0.0, 0.0), (3.0, 0.0), (7.0, 0.0))):
+    vt = cfg.vocal_tract
+    return vt.model_copy(update={"grid": vt.grid.model_copy(update={"spine_cm": [list(p) for p in spine]}),
+                                 "area_law": regions})
+
+
+def _run(vt, inner, outer, lip_area=2.0, lip_length=1.0):
+    grid = tract_grid(vt)
+    law = vt.area_law
+    return grid, area_functions(grid, segments(inner)[None], segments(outer), np.array([r.alpha for r in law]),
+                                np.array([r.beta for r in law]), tuple(r.name for r in law), np.array([lip_length]),
+                                np.array([lip_area]), vt.lip_sections, vt.grid.penetration_cm)
+
+
+def test_a_straight_channel_gives_the_power_law_exactly_and_its_length(cfg):
+    vt = _channel_tract(cfg, [AreaRegion(name="all", until_cm=99.0, alpha=1.7, beta=1.3)])
+    inner = [np.array([[-1.0, -0.3], [8.0, -0.3]])]
+    outer = [np.array([[-1.0, 0.5], [8.0, 0.5]])]
+    grid, af = _run(vt, inner, outer)
+    n = grid.n_lines
+    assert n == int(np.ceil(7.0 / vt.grid.spacing_cm)) + 1
+    np.testing.assert_allclose(af.distance_cm[0], 0.8, atol=1e-12)
+    np.testing.assert_allclose(af.area_cm2[0, :n], 1.7 * 0.8 ** 1.3, rtol=1e-12)
+    assert af.length_cm[0, :n].sum() == pytest.approx(7.0, abs=1e-9)
+    assert af.tract_length_cm[0] == pytest.approx(8.0, abs=1e-9)  # plus the 1-cm lip tube
+    np.testing.assert_allclose(af.area_cm2[0, n:], 2.0)
+
+
+def test_regions_use_their_own_coefficients(cfg):
+    vt = _channel_tract(cfg, [AreaRegion(name="back", until_cm=3.0, alpha=1.0, beta=1.0),
+                              AreaRegion(name="front", until_cm=99.0, alpha=3.0, beta=2.0)])
+    grid, af = _run(vt, [np.array([[-1.0, -0.5], [8.0, -0.5]])], [np.array([[-1.0, 0.5], [8.0, 0.5]])])
+    back = grid.arc_cm <= 3.0
+    np.testing.assert_allclose(af.area_cm2[0, :grid.n_lines][back], 1.0)
+    np.testing.assert_allclose(af.area_cm2[0, :grid.n_lines][~back], 3.0)
+
+
+def test_a_tongue_through_the_wall_reads_a_closure_and_a_missing_contour_reads_nan(cfg):
+    vt = _channel_tract(cfg, [AreaRegion(name="all", until_cm=99.0, alpha=1.7, beta=1.3)])
+    # the inner contour rises through the wall between x = 3 and 4, and stops at x = 6
+    inner = [np.array([[-1.0, -0.3], [3.0, -0.3], [3.2, 0.6], [3.8, 0.6], [4.0, -0.3], [6.0, -0.3]])]
+    grid, af = _run(vt, inner, [np.array([[-1.0, 0.5], [8.0, 0.5]])])
+    x = grid.origin[:, 0]
+    assert (af.area_cm2[0, :grid.n_lines][(x > 3.25) & (x < 3.75)] == 0.0).all()
+    assert np.isnan(af.distance_cm[0][x > 6.05]).all()
+    assert np.isfinite(af.distance_cm[0][x < 2.9]).all()
+
+
+def test_tract_controls_follow_a_smooth_ramp():
+    start = {"lip_area_cm2": 3.0, "lip_length_cm": 1.0, "velum_port_cm2": 0.0}
+    t = np.linspace(0.0, 0.3, 301)
+    c = tract_controls([TractEntry(at_ms=100, ramp_ms=60, lip_area_cm2=0.5)], start, t)
+    a = c["lip_area_cm2"]
+    assert (a[t < 0.1] == 3.0).all() and (a[t >= 0.16] == pytest.approx(0.5))
+    assert a[np.argmin(abs(t - 0.13))] == pytest.approx(1.75, abs=1e-9)  # half-way at half the ramp
+    assert (np.diff(a) <= 1e-12).all()  # monotone, no overshoot
+    assert (c["velum_port_cm2"] == 0.0).all() and (c["lip_length_cm"] == 1.0).all()
