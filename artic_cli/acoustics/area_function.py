@@ -21,8 +21,12 @@ _EPS = 1e-12
 
 
 def segments(polylines) -> np.ndarray:
-    """(S, 2, 2): every segment of the polylines, as (start, end) points."""
-    return np.concatenate([np.stack([p[:-1], p[1:]], axis=1) for p in polylines if len(p) > 1])
+    """(S, 2, 2): every segment of the polylines (n, 2), as (start, end) points; for polylines of F frames
+    (F, n, 2), (F, S, 2, 2)."""
+    axis = np.ndim(polylines[0]) - 2
+    take = lambda p, a, b: p[:, a:b] if axis else p[a:b]  # noqa: E731
+    return np.concatenate([np.stack([take(p, None, -1), take(p, 1, None)], axis=axis + 1)
+                           for p in polylines if p.shape[axis] > 1], axis=axis)
 
 
 def crossings(grid: Grid, segs: np.ndarray) -> np.ndarray:
@@ -125,3 +129,35 @@ def area_functions(grid: Grid, inner: np.ndarray, outer: np.ndarray, alpha: np.n
                          area_cm2=np.concatenate([area, lip_area.reshape(f, -1)], axis=1), region=region,
                          region_names=names, distance_cm=d, inner_s_cm=inner_s, wall_s_cm=wall_s,
                          midline_cm=midline)
+
+
+def band_areas(grid: Grid, inners: list[np.ndarray], outers: list[np.ndarray], z_cm: np.ndarray,
+               inner_mid_s: np.ndarray, wall_mid_s: np.ndarray) -> np.ndarray:
+    """The cross-section of the band |z| <= z_cm[-1] from the distances in parasagittal planes: inner
+    contours (F, S, 2, 2) and outer ones (S', 2, 2) per plane at ``z_cm`` (the first, 0, is the midsagittal
+    one), A = 2 int d(z) dz by the trapezoid rule (the model is symmetric); (F, L) cm^2.  In a lateral plane
+    each line takes the crossings nearest to its midsagittal ones (``inner_mid_s`` (F, L), ``wall_mid_s``
+    (L,)): the lateral wall lies lower than the spine in the mouth, so "the first crossing beyond the spine"
+    does not hold there; NaN where a plane's line misses a contour."""
+    d = []
+    for k, (inner, outer) in enumerate(zip(inners, outers)):
+        if k == 0:
+            with np.errstate(invalid="ignore"):
+                d.append(np.maximum(wall_mid_s[None, :] - inner_mid_s, 0.0))
+            continue
+        w = crossings(grid, outer[None])[0]  # (L, S')
+        wall_s = _nearest(w[None], wall_mid_s[None, :])[0]
+        ref = np.where(np.isfinite(inner_mid_s), inner_mid_s, wall_mid_s[None, :])
+        inner_s = _nearest(crossings(grid, inner), ref)
+        with np.errstate(invalid="ignore"):
+            d.append(np.maximum(wall_s[None, :] - inner_s, 0.0))
+    return 2.0 * np.trapezoid(np.stack(d), np.asarray(z_cm, float), axis=0)
+
+
+def _nearest(s: np.ndarray, ref: np.ndarray) -> np.ndarray:
+    """The crossing s (F, L, S) nearest to ``ref`` (F, L) per line; NaN where there is none."""
+    gap = np.abs(s - ref[..., None])
+    gap = np.where(np.isnan(gap), np.inf, gap)
+    k = np.argmin(gap, axis=2)
+    out = np.take_along_axis(s, k[..., None], axis=2)[..., 0]
+    return np.where(np.isfinite(np.take_along_axis(gap, k[..., None], axis=2)[..., 0]), out, np.nan)

@@ -67,9 +67,30 @@ def tract_grid(vt: VocalTract) -> Grid:
 
 
 def apply_rigid(points: np.ndarray, rotation: np.ndarray, translation: np.ndarray) -> np.ndarray:
-    """Midsagittal points (n, 2) moved by a rigid motion of 3-D space (R (3,3), t (3,)), taken at z = 0."""
+    """Midsagittal points (n, 2) moved by a rigid motion of 3-D space (R (3,3), t (3,)), taken at z = 0;
+    with R (F, 3, 3) and t (F, 3), every frame's: (F, n, 2)."""
     p = np.column_stack([points, np.zeros(len(points))])
+    if np.ndim(rotation) == 3:
+        return (np.einsum("fij,nj->fni", rotation, p) + translation[:, None, :])[..., :2]
     return (p @ rotation.T + translation)[:, :2]
+
+
+def moving_parts(vt: VocalTract, tongue_cm: np.ndarray, rotation: np.ndarray, translation: np.ndarray
+                 ) -> dict[str, np.ndarray]:
+    """The moving parts of F frames, (F, n, 2) each: the tongue surface (root to tip, from a tip-first
+    (F, n, 2) surface), the lower incisor and the lower lip (the mandible's R (F, 3, 3), t (F, 3))."""
+    return {"tongue": np.asarray(tongue_cm, float)[:, ::-1],
+            "lower_incisor": apply_rigid(np.asarray(vt.lower_incisor_cm, float), rotation, translation),
+            "lower_lip": apply_rigid(np.asarray(vt.lower_lip_cm, float), rotation, translation)}
+
+
+def inner_polylines(vt: VocalTract, moving: dict[str, np.ndarray]) -> list[np.ndarray]:
+    """The inner contour of F frames as polylines (F, n, 2): larynx front, tongue (root to tip), the bridge
+    from the tip to the lower incisor edge, the lower incisor."""
+    tongue, incisor = moving["tongue"], moving["lower_incisor"]
+    larynx = np.broadcast_to(np.asarray(vt.larynx_front_cm, float), (len(tongue), len(vt.larynx_front_cm), 2))
+    bridge = np.stack([tongue[:, -1], incisor[:, 0]], axis=1)
+    return [larynx, tongue, bridge, incisor]
 
 
 @dataclass(frozen=True)
@@ -106,3 +127,30 @@ def outline(vt: VocalTract, wall: WallGeometry, tongue_cm: np.ndarray, jaw: tupl
                  upper_lip=np.asarray(vt.upper_lip_cm, float),
                  velum_nasal=np.asarray(vt.velum_nasal_surface_cm, float))
     return Outline(inner=(larynx, tongue, bridge, lower_incisor), outer=tuple(fixed.values()), drawn=drawn)
+
+
+def wall_at(wall: WallGeometry, z: float, points: int = 40) -> dict[str, np.ndarray]:
+    """The contact wall's outlines (palate with velum, pharynx) at lateral offset ``z`` (cm), linear between
+    the config's slices (each resampled to ``points`` points by arc length)."""
+    slices = sorted(wall.slices, key=lambda sl: sl.z_cm)
+    zs = np.array([sl.z_cm for sl in slices])
+    if not zs[0] <= z <= zs[-1]:
+        raise ValueError(f"z = {z} cm is outside the wall's slices ({zs[0]}-{zs[-1]} cm)")
+    j = int(np.clip(np.searchsorted(zs, z, side="right") - 1, 0, len(zs) - 2))
+    w = (z - zs[j]) / (zs[j + 1] - zs[j])
+    out = {}
+    for part in ("palate", "pharynx"):
+        a = resample_polyline(getattr(slices[j], part), points)
+        b = resample_polyline(getattr(slices[j + 1], part), points)
+        out[part] = (1 - w) * a + w * b
+    return out
+
+
+def outer_at(vt: VocalTract, wall: WallGeometry, z: float) -> tuple[np.ndarray, ...]:
+    """The fixed outer contour's polylines in the plane at ``z`` (cm)."""
+    fixed = outer_contour(vt, wall)
+    if z == 0.0:
+        return tuple(fixed.values())
+    side = wall_at(wall, z)
+    return (np.vstack([side["pharynx"], np.asarray(vt.pharynx_lower_cm, float)]), side["palate"], fixed["port"],
+            fixed["upper_incisor"])

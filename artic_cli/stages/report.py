@@ -283,6 +283,13 @@ def tract_section(data: Path) -> tuple[list[Row], list[str]]:
             Row("rest tract: smallest area (grid)", "open vowel [e]: no constriction",
                 f"{grid_area.min():.2f} cm^2 at {pos[0]:.1f} cm ({rest.af.region_names[int(reg[0])]})",
                 _verdict(grid_area.min() >= 0.15, "at least 0.15 cm^2"))]
+    if rest.band_area_cm2 is not None:
+        ratio = rest.band_area_cm2[0] / np.where(grid_area > 0, grid_area, np.nan)
+        by_region = ", ".join(f"{name} {np.nanmedian(ratio[rest.grid.region == i]):.2f}"
+                              for i, name in enumerate(rest.af.region_names[:-1]) if (rest.grid.region == i).any())
+        med = float(np.nanmedian(ratio))
+        rows.append(Row("rest tract: 3-D band area / power law", "the paper: midsagittal distances and laws",
+                        f"median {med:.2f} ({by_region})", _verdict(0.5 <= med <= 2.0, "median within a factor 2")))
     lines = ["![The rest tract: midsagittal view, grid and area function](tract_rest.png)", ""]
     for path in sorted((data / "tracts").glob("*.h5")):
         if path.stem == "rest":

@@ -17,10 +17,10 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from ..acoustics.area_function import AreaFunctions, area_functions, segments
+from ..acoustics.area_function import AreaFunctions, area_functions, band_areas, segments
 from ..config import Config, VocalTract, load_config
 from ..errors import ArticError
-from ..geometry.tract import Grid, outline, outer_contour, tract_grid
+from ..geometry.tract import Grid, inner_polylines, moving_parts, outer_at, outer_contour, tract_grid
 from ..io.fingerprint import digest, sections_hash
 from ..io.store import Provenance, atomic_h5, atomic_path, open_artifact
 from ..mechanics.contact import rigid_motion
@@ -51,20 +51,30 @@ class Shapes:
     tongue_cm: np.ndarray  # (F, n, 2) the tongue's midsagittal surface, tip first
     jaw_rotation: np.ndarray  # (F, 3, 3) the mandible's rigid motion from its rest
     jaw_translation: np.ndarray  # (F, 3)
+    tongue_lateral_cm: np.ndarray | None = None  # (F, n, 2) the surface in the parasagittal plane at +lateral_z_cm
+    lateral_z_cm: float = 0.0
 
 
-def shapes_of(positions: np.ndarray, time_s: np.ndarray, surface: np.ndarray, rest: np.ndarray | None,
+def surface_nodes(mesh) -> tuple[np.ndarray, np.ndarray]:
+    """The tongue's surface nodes, tip first: in the midsagittal plane and in the left (+z) plane."""
+    rows = np.asarray(mesh.node_sets["surface"]).reshape(-1, 3)  # (radial lines, planes -z / 0 / +z)
+    return rows[:, 1], rows[:, 2]
+
+
+def shapes_of(positions: np.ndarray, time_s: np.ndarray, mesh, rest: np.ndarray | None,
               mandible: np.ndarray | None) -> Shapes:
-    """Shapes from node positions (F, N, 3): the midsagittal surface nodes (tip first) and the mandible's
-    nodes against their rest (no mandible: the jaw stays at rest)."""
+    """Shapes from node positions (F, N, 3): the surface nodes (tip first) in the midsagittal and the left
+    plane, and the mandible's nodes against their rest (no mandible: the jaw stays at rest)."""
+    mid, lateral = surface_nodes(mesh)
     f = len(positions)
     rot = np.broadcast_to(np.eye(3), (f, 3, 3)).copy()
     tr = np.zeros((f, 3))
     if mandible is not None and len(mandible) >= 3 and rest is not None:
         for k in range(f):
             rot[k], tr[k] = rigid_motion(rest[mandible], positions[k, mandible])
-    return Shapes(time_s=np.asarray(time_s, float), tongue_cm=positions[:, surface, :2].copy(), jaw_rotation=rot,
-                  jaw_translation=tr)
+    return Shapes(time_s=np.asarray(time_s, float), tongue_cm=positions[:, mid, :2].copy(), jaw_rotation=rot,
+                  jaw_translation=tr, tongue_lateral_cm=positions[:, lateral, :2].copy(),
+                  lateral_z_cm=float(np.mean(mesh.nodes[lateral, 2])))
 
 
 @dataclass
@@ -77,19 +87,55 @@ class Tracts:
     grid: Grid
     contours: dict[str, np.ndarray]  # moving parts (F, n, 2): tongue, lower_incisor, lower_lip
     fixed: dict[str, np.ndarray] = field(default_factory=dict)  # fixed parts (n, 2)
+    band_area_cm2: np.ndarray | None = None  # (F, L) the central band |z| <= band_z_cm[-1] from the 3-D geometry
+    band_z_cm: np.ndarray | None = None
 
     @property
     def n_frames(self) -> int:
         return len(self.time_s)
 
 
+@dataclass(frozen=True)
+class Fixed:
+    """What does not move: the grid and the outer contour's segments in each plane (cm)."""
+
+    grid: Grid
+    outer: dict[float, np.ndarray]  # z -> (S, 2, 2)
+    drawn: dict[str, np.ndarray]
+
+
+_FIXED: dict[tuple, tuple] = {}
+
+
+def fixed_geometry(vt: VocalTract, cfg_wall, planes_z: tuple[float, ...] = (0.0,)) -> Fixed:
+    """The fixed geometry, built once per tract, wall and set of planes (the config objects are kept with
+    it, so their ids stay theirs)."""
+    key = (id(vt), id(cfg_wall), tuple(planes_z))
+    if key not in _FIXED:
+        fixed = outer_contour(vt, cfg_wall)
+        drawn = dict(fixed, larynx_front=np.asarray(vt.larynx_front_cm, float),
+                     upper_lip=np.asarray(vt.upper_lip_cm, float),
+                     velum_nasal=np.asarray(vt.velum_nasal_surface_cm, float))
+        outer = {float(z): segments(list(outer_at(vt, cfg_wall, float(z)))) for z in planes_z}
+        if len(_FIXED) > 8:
+            _FIXED.clear()
+        _FIXED[key] = (Fixed(grid=tract_grid(vt), outer=outer, drawn=drawn), vt, cfg_wall)
+    return _FIXED[key][0]
+
+
+def band_planes(shapes: Shapes) -> tuple[float, ...]:
+    """The planes the band is integrated over: midsagittal, half-way, the tongue's lateral plane (cm)."""
+    w = shapes.lateral_z_cm
+    return (0.0, 0.5 * w, w) if shapes.tongue_lateral_cm is not None and w > 0 else (0.0,)
+
+
 def compute(vt: VocalTract, cfg_wall, shapes: Shapes, controls: dict[str, np.ndarray]) -> Tracts:
     """The tracts of every frame; a line that misses the tract's contours is an error naming the frame."""
-    grid = tract_grid(vt)
-    outlines = [outline(vt, cfg_wall, shapes.tongue_cm[k], (shapes.jaw_rotation[k], shapes.jaw_translation[k]))
-                for k in range(len(shapes.time_s))]
-    inner = np.stack([segments(o.inner) for o in outlines])
-    outer = segments(outlines[0].outer)
+    geo = fixed_geometry(vt, cfg_wall, band_planes(shapes))
+    grid = geo.grid
+    moving = moving_parts(vt, shapes.tongue_cm, shapes.jaw_rotation, shapes.jaw_translation)
+    inner = segments(inner_polylines(vt, moving))
+    outer = geo.outer[0.0]
     law = vt.area_law
     af = area_functions(grid, inner, outer, np.array([r.alpha for r in law]), np.array([r.beta for r in law]),
                         tuple(r.name for r in law), controls["lip_length_cm"], controls["lip_area_cm2"],
@@ -105,9 +151,21 @@ def compute(vt: VocalTract, cfg_wall, shapes: Shapes, controls: dict[str, np.nda
         raise ArticError(f"frame {fr} (t = {shapes.time_s[fr]:.3f} s): the midline cannot be traced, grid line {k} "
                          f"({grid.arc_cm[k]:.2f} cm from the glottis) meets no tongue or larynx within "
                          f"{grid.reach_cm:g} cm; the shape left the grid (raise vocal_tract.grid.reach_cm)")
-    moving = {name: np.stack([o.drawn[name] for o in outlines]) for name in ("tongue", "lower_incisor", "lower_lip")}
-    fixed = {k: v for k, v in outlines[0].drawn.items() if k not in moving}
-    return Tracts(time_s=shapes.time_s, af=af, controls=controls, grid=grid, contours=moving, fixed=fixed)
+    band, z = None, None
+    if len(geo.outer) > 1:
+        band, z = band_area(vt, geo, shapes, af)
+    return Tracts(time_s=shapes.time_s, af=af, controls=controls, grid=grid, contours=moving, fixed=dict(geo.drawn),
+                  band_area_cm2=band, band_z_cm=z)
+
+
+def band_area(vt: VocalTract, geo: Fixed, shapes: Shapes, af: AreaFunctions) -> tuple[np.ndarray, np.ndarray]:
+    """The cross-section of the band the tongue mesh spans (|z| <= its lateral planes) from the 3-D geometry:
+    distances in the midsagittal plane, half-way and in the lateral plane, integrated across."""
+    z = np.array(list(geo.outer))
+    planes = [shapes.tongue_cm, 0.5 * (shapes.tongue_cm + shapes.tongue_lateral_cm), shapes.tongue_lateral_cm]
+    inners = [segments(inner_polylines(vt, moving_parts(vt, tongue, shapes.jaw_rotation, shapes.jaw_translation)))
+              for tongue in planes]
+    return band_areas(geo.grid, inners, list(geo.outer.values()), z, af.inner_s_cm, af.wall_s_cm), z
 
 
 def default_controls(vt: VocalTract) -> dict[str, float]:
@@ -157,6 +215,10 @@ def write(path: Path | str, t: Tracts, prov: Provenance | None = None, extra: di
                                  ("grid/wall_s_cm", af.wall_s_cm, "cm along each line"),
                                  ("midline_cm", af.midline_cm, "cm")]:
             f.create_dataset(name, data=data, compression="gzip" if np.ndim(data) > 1 else None).attrs["units"] = unit
+        if t.band_area_cm2 is not None:
+            f.create_dataset("band/area_cm2", data=t.band_area_cm2, compression="gzip").attrs["units"] = (
+                "cm^2 (frames x grid lines): the band |z| <= band/z_cm[-1] from the 3-D geometry")
+            f.create_dataset("band/z_cm", data=t.band_z_cm).attrs["units"] = "cm"
         for name, data in t.contours.items():
             f.create_dataset(f"contours/{name}", data=data, compression="gzip").attrs["units"] = "cm (frames x points x 2)"
         for name, data in t.fixed.items():
@@ -177,7 +239,10 @@ def read(path: Path | str) -> Tracts:
                         "lip_length_cm": f["lips/length_cm"][()]}
             contours = {k: v[()] for k, v in f["contours"].items() if k != "fixed"}
             fixed = {k: v[()] for k, v in f["contours/fixed"].items()}
-            return Tracts(time_s=f["time"][()], af=af, controls=controls, grid=grid, contours=contours, fixed=fixed)
+            band = f["band/area_cm2"][()] if "band" in f else None
+            band_z = f["band/z_cm"][()] if "band" in f else None
+            return Tracts(time_s=f["time"][()], af=af, controls=controls, grid=grid, contours=contours, fixed=fixed,
+                          band_area_cm2=band, band_z_cm=band_z)
         except (KeyError, ValueError, OSError) as err:
             raise ArticError(f"{path} is damaged or incomplete ({type(err).__name__}); {STAGE.hint}") from None
 
@@ -217,7 +282,7 @@ def shapes_of_simulation(sim, mesh) -> Shapes:
     if mandible is not None and sim.rest_cm is None:
         raise ArticError("the simulation file records no rest positions (an older artic wrote it); rerun "
                          "'artic simulate'")
-    return shapes_of(sim.positions_cm, sim.time_s, mesh.node_sets["midsagittal_surface"], sim.rest_cm, mandible)
+    return shapes_of(sim.positions_cm, sim.time_s, mesh, sim.rest_cm, mandible)
 
 
 def rest_shapes(cfg: Config, m) -> Shapes:
@@ -226,8 +291,7 @@ def rest_shapes(cfg: Config, m) -> Shapes:
 
     model = simulate_stage.build(cfg, m.mesh, m.wall)
     st = settle(model)
-    return shapes_of(st.x[None], np.zeros(1), m.mesh.node_sets["midsagittal_surface"], model.rest,
-                     np.asarray(model.node_sets["mandible"]))
+    return shapes_of(st.x[None], np.zeros(1), m.mesh, model.rest, np.asarray(model.node_sets["mandible"]))
 
 
 def parse_ep(spec: str) -> tuple[str, dict[str, float]]:
@@ -265,7 +329,7 @@ def ep_shapes(cfg: Config, m, maps, spec: str) -> tuple[Shapes, dict[str, float]
     model = simulate_stage.build(cfg, m.mesh, m.wall)
     start = jaw_rest(model, jm.forces)
     state, _ = equilibrium_state(model, start, add_forces(jm.forces, forces), STAGE.view(cfg).epmap)
-    return shapes_of(state.x[None], np.zeros(1), m.mesh.node_sets["midsagittal_surface"], model.rest,
+    return shapes_of(state.x[None], np.zeros(1), m.mesh, model.rest,
                      np.asarray(model.node_sets["mandible"])), add_forces(jm.forces, forces)
 
 

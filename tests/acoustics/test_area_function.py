@@ -68,3 +68,18 @@ def test_tract_controls_follow_a_smooth_ramp():
     assert a[np.argmin(abs(t - 0.13))] == pytest.approx(1.75, abs=1e-9)  # half-way at half the ramp
     assert (np.diff(a) <= 1e-12).all()  # monotone, no overshoot
     assert (c["velum_port_cm2"] == 0.0).all() and (c["lip_length_cm"] == 1.0).all()
+
+
+def test_the_band_area_of_a_uniform_slab_is_its_width_times_its_depth(cfg):
+    from artic_cli.acoustics.area_function import band_areas
+
+    vt = _channel_tract(cfg, [AreaRegion(name="all", until_cm=99.0, alpha=1.7, beta=1.3)])
+    inner = [np.array([[-1.0, -0.3], [8.0, -0.3]])]
+    outer = [np.array([[-1.0, 0.5], [8.0, 0.5]])]
+    grid, af = _run(vt, inner, outer)
+    # the same channel in every plane, the lateral wall 0.2 cm lower: depth 0.8 in the middle, 0.6 at the side
+    side = [np.array([[-1.0, 0.3], [8.0, 0.3]])]
+    planes = [segments(inner)[None]] * 3
+    outers = [segments(outer), segments([(outer[0] + side[0]) / 2]), segments(side)]
+    band = band_areas(grid, planes, outers, np.array([0.0, 0.5, 1.0]), af.inner_s_cm, af.wall_s_cm)
+    np.testing.assert_allclose(band, 2 * (0.25 * 0.8 + 0.5 * 0.7 + 0.25 * 0.6), rtol=1e-12)
