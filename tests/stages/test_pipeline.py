@@ -109,3 +109,29 @@ def test_a_missing_config_stops_the_first_stage(tmp_path):
     assert res.returncode != 0
     assert "config not found: configs/missing.yaml" in res.stderr
     assert not (tmp_path / "mesh.h5").exists() and not (tmp_path / "reports" / "paper.md").exists()
+
+
+def test_the_tracts_of_the_pipeline_and_of_one_ep(built, tmp_path):
+    from artic_cli.errors import ArticError
+    from artic_cli.stages import vocal_tract as vts
+
+    rest = vts.read(built / "tracts" / "rest.h5")
+    assert 16.5 <= rest.af.tract_length_cm[0] <= 18.0
+    for name in ("fig4_ggp", "fig4_sg", "art_sg_jo"):
+        t = vts.read(built / "tracts" / f"{name}.h5")
+        with h5py.File(built / "sims" / f"{name}.h5", "r") as f:
+            assert t.n_frames == f["time"].shape[0]
+    cfg = ROOT / "configs" / "ci_thin.yaml"
+    ep = vts.vocal_tract(ep="JO_0.5:SG=4", epmaps=built / "epmaps.h5", mesh=built / "mesh.h5", config=cfg,
+                         out=tmp_path / "ep.h5").tracts
+    assert ep.n_frames == 1 and (ep.af.area_cm2 >= 0).all()
+    # SG at 4 N pulls the dorsum up and back: the velar region narrows against the rest tract (by a third)
+    velar = ep.grid.region == ep.af.region_names.index("velum")
+    assert ep.af.area_cm2[0, :ep.grid.n_lines][velar].min() < 0.8 * rest.af.area_cm2[0, :rest.grid.n_lines][velar].min()
+    with pytest.raises(ArticError, match="not an EP of the maps"):
+        vts.vocal_tract(ep="JO_0.5:SG=3", epmaps=built / "epmaps.h5", mesh=built / "mesh.h5", config=cfg,
+                        out=tmp_path / "bad.h5")
+    with pytest.raises(ArticError, match="no jaw position"):
+        vts.vocal_tract(ep="JO_9:SG=4", epmaps=built / "epmaps.h5", mesh=built / "mesh.h5", config=cfg,
+                        out=tmp_path / "bad.h5")
+    assert not (tmp_path / "bad.h5").exists()
