@@ -129,3 +129,29 @@ def test_the_command_line_says_one_line_and_exits_2(work, mesh_file, dorsum_sim)
                                   str(CONFIG), "--out", str(work / "cli.h5"), "--csv", str(work / "cli.csv")])
     assert ok.exit_code == 0, ok.output
     assert (work / "cli.csv").is_file()
+
+
+def test_a_simulation_of_another_config_or_an_untraceable_shape_is_refused(work, mesh_file, dorsum_sim, cfg):
+    other = work / "stiffer_contact.yaml"
+    data = yaml.safe_load(CONFIG.read_text())
+    data["contact"] = {"stiffness_n_per_cm": 2000.0}
+    other.write_text(yaml.safe_dump(data))
+    with pytest.raises(ArticError, match="another config"):
+        vts.vocal_tract(sim=dorsum_sim, mesh=mesh_file, config=other, out=work / "bad2.h5")
+    from artic_cli.stages.simulate import read
+    from artic_cli.stages.mesh import read as read_mesh
+
+    shapes = vts.shapes_of_simulation(read(dorsum_sim), read_mesh(mesh_file).mesh)
+    shapes.tongue_cm[-1] -= np.array([0.0, 6.0])  # the last frame's tongue dropped out of the grid's reach
+    with pytest.raises(ArticError, match="midline cannot be traced"):
+        vts.compute(cfg.vocal_tract, cfg.speaker.wall, shapes, vts.controls_for(cfg.vocal_tract, shapes.time_s))
+    assert not (work / "bad2.h5").exists()
+
+
+def test_a_schedule_s_tract_entries_are_validated():
+    from artic_cli.schedule import parse_schedule
+
+    for bad in ({"at_ms": 0, "lip_area_cm2": -0.5}, {"at_ms": 0, "velum_port_cm2": float("nan")},
+                {"at_ms": -5, "lip_length_cm": 1.0}, {"at_ms": 0, "lip_size": 1.0}):
+        with pytest.raises(ArticError, match="tract"):
+            parse_schedule({"tract": [bad]}, "s.yaml")
