@@ -595,34 +595,58 @@ def report_cmd(
 @app.command("acoustics")
 @handle_errors
 def acoustics_cmd(
-    tube: Path = typer.Option(..., "--tube", help="Tube (CSV): header length_cm,area_cm2, one row per section "
-                                                  "from the glottis to the lips."),
+    tube: Optional[Path] = typer.Option(None, "--tube", help="Tube (CSV): header length_cm,area_cm2, one row per "
+                                                             "section from the glottis to the lips."),
+    tracts: Optional[Path] = typer.Option(None, "--tracts", help="Vocal-tract file from 'artic vocal-tract': every "
+                                                                 "frame (or --frame K)."),
+    frame: Optional[int] = typer.Option(None, "--frame", help="With --tracts: one frame (default: all)."),
     config: Optional[Path] = typer.Option(None, "--config", help="Config (its 'acoustics' section: air, walls, "
                                                                  "losses, branches)."),
     lossless: bool = typer.Option(False, "--lossless", help="The ideal hard-walled tube: no losses, an ideal "
                                                             "open end, no side branches."),
     velum_area: Optional[float] = typer.Option(None, "--velum-area", help="Velopharyngeal port opening, cm^2 "
-                                                                          "(default: the config's, 0 = closed)."),
-    as_json: bool = typer.Option(False, "--json", help="Print formants_hz and bandwidths_hz as JSON."),
-    out: Optional[Path] = typer.Option(None, "--out", help="Write the transfer function and formants (HDF5)."),
-    plot: Optional[Path] = typer.Option(None, "--plot", help="Draw the transfer function with the formants (PNG)."),
+                                                                          "(default: the tracts' or the config's, "
+                                                                          "0 = closed)."),
+    as_json: bool = typer.Option(False, "--json", help="Print formants_hz and bandwidths_hz as JSON (the last "
+                                                       "frame's, with time_s, for tracts)."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Write the transfer functions and formants (HDF5)."),
+    plot: Optional[Path] = typer.Option(None, "--plot", help="Draw the transfer function with the formants, or "
+                                                             "for several frames the formant tracks (PNG)."),
 ):
-    """Transfer function, radiated spectrum, formants F1-F5 and bandwidths of a tube."""
-    from ..stages.acoustics import tube_acoustics
+    """Transfer function, radiated spectrum, formants F1-F5 and bandwidths of a tube or of vocal-tract frames."""
+    from ..stages.acoustics import tract_acoustics, tube_acoustics
 
-    r = tube_acoustics(tube, config, lossless, velum_area, out)
-    fm = [None if not np.isfinite(v) else round(float(v), 2) for v in r.formants_hz[0]]
-    bw = [None if not np.isfinite(v) else round(float(v), 2) for v in r.bandwidths_hz[0]]
+    if (tube is None) == (tracts is None):
+        raise ArticError("give one of --tube FILE.csv or --tracts FILE.h5")
+    if tube is not None and frame is not None:
+        raise ArticError("--frame is for --tracts; a tube has one frame")
+    if tube is not None:
+        r = tube_acoustics(tube, config, lossless, velum_area, out)
+        name = tube.name
+    else:
+        r = _with_progress("formants", lambda update: tract_acoustics(tracts, config, frame, lossless, velum_area,
+                                                                      out, progress=update))
+        name = tracts.name
+    last = len(r.formants_hz) - 1
+    fm = [None if not np.isfinite(v) else round(float(v), 2) for v in r.formants_hz[last]]
+    bw = [None if not np.isfinite(v) else round(float(v), 2) for v in r.bandwidths_hz[last]]
     if plot is not None:
-        from ..plots.acoustics import plot_transfer
+        from ..plots.acoustics import plot_tracks, plot_transfer
 
-        plot_transfer(r, 0, plot, title=f"{tube.name}{' (lossless)' if lossless else ''}")
+        if len(r.formants_hz) > 1:
+            plot_tracks(r, plot, title=f"{name}: formant tracks")
+        else:
+            plot_transfer(r, 0, plot, title=f"{name}{' (lossless)' if lossless else ''}")
     if as_json:
-        out_console.print_json(json.dumps({"formants_hz": fm, "bandwidths_hz": bw}))
+        doc = {"formants_hz": fm, "bandwidths_hz": bw}
+        if r.time_s is not None:
+            doc["time_s"] = float(r.time_s[last])
+        out_console.print_json(json.dumps(doc))
         return
-    _print_table(f"formants of {tube}", ("formant", "frequency Hz", "bandwidth Hz"),
-                 [(f"F{k + 1}", "" if f is None else f"{f:.1f}", "" if b is None else f"{b:.1f}")
-                  for k, (f, b) in enumerate(zip(fm, bw))], left=("formant",))
+    rows = [(f"F{k + 1}", "" if f is None else f"{f:.1f}", "" if b is None else f"{b:.1f}")
+            for k, (f, b) in enumerate(zip(fm, bw))]
+    when = "" if r.time_s is None else f" at t = {r.time_s[last]:.3f} s ({len(r.formants_hz)} frames)"
+    _print_table(f"formants of {name}{when}", ("formant", "frequency Hz", "bandwidth Hz"), rows, left=("formant",))
     for p in (out, plot):
         if p is not None:
             out_console.print(f"wrote {p}", highlight=False)
@@ -681,20 +705,41 @@ def vocal_tract_cmd(
 @app.command("synthesize")
 @handle_errors
 def synthesize_cmd(
-    tube: Path = typer.Option(..., "--tube", help="Tube (CSV): header length_cm,area_cm2, glottis first."),
     out: Path = typer.Option(..., "--out", help="Sound to write (WAV, 16-bit PCM)."),
-    duration: float = typer.Option(1.0, "--duration", help="How long the tube is held and voiced, s."),
+    tube: Optional[Path] = typer.Option(None, "--tube", help="Tube (CSV): header length_cm,area_cm2, glottis first."),
+    tracts: Optional[Path] = typer.Option(None, "--tracts", help="Vocal-tract file: its frames, areas interpolated "
+                                                                 "sample by sample."),
+    duration: Optional[float] = typer.Option(None, "--duration", help="How long, s (default: a tube 1 s, tracts "
+                                                                      "their frames' span)."),
     f0: float = typer.Option(110.0, "--f0", help="Fundamental frequency, Hz (50-500)."),
     f0_contour: Optional[Path] = typer.Option(None, "--f0-contour", help="F0 over time instead (CSV: "
                                                                           "time_s,f0_hz)."),
+    amplitude_contour: Optional[Path] = typer.Option(None, "--amplitude-contour", help="The voice's gain over time "
+                                                                                        "(CSV: time_s,amplitude)."),
+    aspiration: float = typer.Option(0.0, "--aspiration", help="Breath noise, relative to the voice's RMS "
+                                                               "(0: none)."),
+    plot: Optional[Path] = typer.Option(None, "--plot", help="Draw the sound's spectrogram (PNG)."),
     config: Optional[Path] = typer.Option(None, "--config", help="Config (its 'acoustics.synthesis' section)."),
 ):
-    """Voice a tube with the LF source through a reflection-type line; write a WAV file."""
-    from ..stages.synthesize import synthesize_tube
+    """Voice a tube or a vocal-tract file with the LF source through a reflection-type line; write a WAV file."""
+    from ..stages.synthesize import synthesize_tracts, synthesize_tube
 
-    a = synthesize_tube(tube, out, duration, f0, f0_contour, config)
+    if (tube is None) == (tracts is None):
+        raise ArticError("give one of --tube FILE.csv or --tracts FILE.h5")
+    if plot is not None and not plot.parent.is_dir():
+        raise ArticError(f"--plot {plot}: the folder {plot.parent} does not exist; create it or give another path")
+    if tube is not None:
+        a = synthesize_tube(tube, out, 1.0 if duration is None else duration, f0, f0_contour, config,
+                            amplitude_contour, aspiration)
+    else:
+        a = synthesize_tracts(tracts, out, f0, f0_contour, config, amplitude_contour, aspiration, duration)
     out_console.print(f"wrote {out}: {len(a.samples) / a.sample_rate_hz:.2f} s at {a.sample_rate_hz} Hz, 16-bit PCM",
                       highlight=False)
+    if plot is not None:
+        from ..plots.acoustics import plot_spectrogram
+
+        out_console.print(f"wrote {plot_spectrogram(a.samples, a.sample_rate_hz, plot, title=out.name)}",
+                          highlight=False)
 
 
 def _plot_mesh(mesh: Path, out: Path, config: Path | None = None) -> Path:

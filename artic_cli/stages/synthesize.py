@@ -1,11 +1,14 @@
-"""Stage ``synthesize``: a WAV file from a tube held for a duration, voiced by the LF source."""
+"""Stage ``synthesize``: a WAV file from a tube held for a duration, or from the frames of a vocal-tract file
+(areas interpolated sample by sample), voiced by the LF source with optional aspiration noise."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Annotated
 
 import numpy as np
+from pydantic import Field
 from scipy.io import wavfile
 from scipy.signal import resample_poly
 
@@ -36,18 +39,50 @@ def f0_track(times_s: np.ndarray, f0: float | None, contour: list[tuple[float, f
     return np.full(len(times_s), float(f0))
 
 
+def frame_areas(lengths_cm: np.ndarray, areas_cm2: np.ndarray, n: int) -> np.ndarray:
+    """(F, n) areas at n equal sections of each frame's own length (frames x sections in)."""
+    return np.stack([resample_tube(lengths_cm[k], areas_cm2[k], n) for k in range(len(areas_cm2))])
+
+
+def source_for(t_s: np.ndarray, fs: float, sy, f0_hz: float | None, contour, amplitude=None,
+               aspiration: float = 0.0, seed: int = 0) -> np.ndarray:
+    """The glottal flow derivative with 20-ms fades at both ends, an amplitude contour ((time_s, gain)
+    points) and aspiration: white noise of ``aspiration`` times the voice's RMS, gated by the glottis's
+    opening phase (noise while air flows)."""
+    src = lf_flow_derivative(f0_track(t_s, f0_hz, contour), fs, sy.lf_tp, sy.lf_te, sy.lf_ta)
+    if aspiration > 0:
+        rms = float(np.sqrt(np.mean(src ** 2))) if len(src) else 0.0
+        gate = (src != 0).astype(float) * 0.5 + 0.5 * (np.abs(src) > 0.05)
+        src = src + aspiration * rms * gate * np.random.default_rng(seed).standard_normal(len(src))
+    gain = np.ones(len(t_s))
+    if amplitude:
+        ta, ga = np.array(amplitude).T
+        gain = np.interp(t_s, ta, ga)
+    fade = np.minimum(1.0, np.minimum(t_s, t_s[-1] - t_s) / 0.02) if len(t_s) else t_s
+    return src * gain * fade
+
+
 def compute(tube: Tube, cfg: Config, duration_s: float, f0_hz: float | None = 110.0,
-            contour: list[tuple[float, float]] | None = None) -> Audio:
+            contour: list[tuple[float, float]] | None = None, amplitude=None, aspiration: float = 0.0) -> Audio:
+    """A tube held for ``duration_s``."""
+    return compute_frames(tube.length_cm[None], tube.area_cm2[None], np.array([0.0]), cfg, duration_s, f0_hz,
+                          contour, amplitude, aspiration)
+
+
+def compute_frames(lengths_cm: np.ndarray, areas_cm2: np.ndarray, times_s: np.ndarray, cfg: Config,
+                   duration_s: float, f0_hz: float | None = 110.0, contour=None, amplitude=None,
+                   aspiration: float = 0.0) -> Audio:
+    """Area functions (frames x sections, glottis first) at ``times_s``, interpolated at the line's rate; the
+    line's sections are cut from the frames' mean length (each frame resampled over its own length)."""
     ac = STAGE.view(cfg).acoustics
     sy = ac.synthesis
     fs = 2 * sy.sample_rate_hz  # the line runs at twice the audio rate
-    n = sections_for(tube.total_length_cm, ac.sound_speed_cm_s, fs)
-    areas = resample_tube(tube.length_cm, tube.area_cm2, n)[None, :]
+    n = sections_for(float(np.mean(lengths_cm.sum(axis=1))), ac.sound_speed_cm_s, fs)
+    areas = frame_areas(lengths_cm, areas_cm2, n)
     t = np.arange(int(round(duration_s * fs))) / fs
-    src = lf_flow_derivative(f0_track(t, f0_hz, contour), fs, sy.lf_tp, sy.lf_te, sy.lf_ta)
-    ramp = np.minimum(1.0, np.minimum(t, t[-1] - t) / 0.02)  # 20-ms fades: no clicks at either end
-    y = synthesize(areas, np.array([0.0]), src * ramp, fs, sy.glottal_reflection, sy.section_loss,
-                   ac.air_density_g_cm3, ac.sound_speed_cm_s)
+    src = source_for(t, fs, sy, f0_hz, contour, amplitude, aspiration)
+    y = synthesize(areas, np.asarray(times_s, float) - float(times_s[0]), src, fs, sy.glottal_reflection,
+                   sy.section_loss, ac.air_density_g_cm3, ac.sound_speed_cm_s)
     y = resample_poly(y, 1, 2)
     peak = float(np.max(np.abs(y))) if len(y) else 0.0
     return Audio(0.9 * y / peak if peak > 0 else y, sy.sample_rate_hz)
@@ -67,6 +102,21 @@ class F0Point(Strict):
     f0_hz: F0Hz
 
 
+class GainPoint(Strict):
+    time_s: NonNegative
+    amplitude: Annotated[float, Field(ge=0, le=10, allow_inf_nan=False)]
+
+
+def read_amplitude_contour(path: Path | str) -> list[tuple[float, float]]:
+    """A CSV ``time_s,amplitude`` (times ascending, gains 0-10; 1 = the voice as is)."""
+    hint = "give a CSV with header time_s,amplitude, times ascending, amplitudes 0-10"
+    out = [(p.time_s, p.amplitude) for p in read_csv(path, ["time_s", "amplitude"], GainPoint, "amplitude contour",
+                                                      hint)]
+    if not out or any(b[0] <= a[0] for a, b in zip(out, out[1:])):
+        raise ArticError(f"{path}: needs at least one point and ascending times; {hint}")
+    return out
+
+
 def read_f0_contour(path: Path | str) -> list[tuple[float, float]]:
     """A CSV ``time_s,f0_hz`` (times ascending, F0 50-500 Hz)."""
     hint = "give a CSV with header time_s,f0_hz, times ascending, F0 50-500 Hz"
@@ -76,19 +126,51 @@ def read_f0_contour(path: Path | str) -> list[tuple[float, float]]:
     return out
 
 
-def synthesize_tube(tube: Path | str, out: Path | str, duration_s: float, f0_hz: float | None = 110.0,
-                    f0_contour: Path | str | None = None, config: Path | str | None = None) -> Audio:
-    check_number("--duration", duration_s, gt=0, le=MAX_DURATION_S, unit="s")
-    if f0_contour is None:
-        check_number("--f0", f0_hz, ge=50, le=500, unit="Hz")
+def _check_out(out: Path | str) -> Path:
     out = Path(out)
     if out.suffix.lower() != ".wav":
         raise ArticError(f"--out {out}: give a .wav file name")
     if not out.parent.is_dir():
         raise ArticError(f"--out {out}: the folder {out.parent} does not exist; create it or give another path")
+    return out
+
+
+def synthesize_tube(tube: Path | str, out: Path | str, duration_s: float, f0_hz: float | None = 110.0,
+                    f0_contour: Path | str | None = None, config: Path | str | None = None,
+                    amplitude_contour: Path | str | None = None, aspiration: float = 0.0) -> Audio:
+    check_number("--duration", duration_s, gt=0, le=MAX_DURATION_S, unit="s")
+    if f0_contour is None:
+        check_number("--f0", f0_hz, ge=50, le=500, unit="Hz")
+    check_number("--aspiration", aspiration, ge=0, le=10)
+    out = _check_out(out)
     cfg = load_config(config)
     t = read_tube_csv(tube)
     contour = read_f0_contour(f0_contour) if f0_contour is not None else None
-    audio = compute(t, cfg, duration_s, f0_hz, contour)
+    amp = read_amplitude_contour(amplitude_contour) if amplitude_contour is not None else None
+    audio = compute(t, cfg, duration_s, f0_hz, contour, amp, aspiration)
+    write(out, audio)
+    return audio
+
+
+def synthesize_tracts(tracts: Path | str, out: Path | str, f0_hz: float | None = 110.0,
+                      f0_contour: Path | str | None = None, config: Path | str | None = None,
+                      amplitude_contour: Path | str | None = None, aspiration: float = 0.0,
+                      duration_s: float | None = None) -> Audio:
+    """The sound of a vocal-tract file's frames (one frame: held for ``duration_s``, default 1 s)."""
+    from . import vocal_tract as vt_stage
+
+    check_number("--duration", duration_s, gt=0, le=MAX_DURATION_S, unit="s")
+    if f0_contour is None:
+        check_number("--f0", f0_hz, ge=50, le=500, unit="Hz")
+    check_number("--aspiration", aspiration, ge=0, le=10)
+    out = _check_out(out)
+    cfg = load_config(config)
+    t = vt_stage.read(tracts)
+    span = float(t.time_s[-1] - t.time_s[0])
+    if duration_s is None:
+        duration_s = span if t.n_frames > 1 and span > 0 else 1.0
+    contour = read_f0_contour(f0_contour) if f0_contour is not None else None
+    amp = read_amplitude_contour(amplitude_contour) if amplitude_contour is not None else None
+    audio = compute_frames(t.af.length_cm, t.af.area_cm2, t.time_s, cfg, duration_s, f0_hz, contour, amp, aspiration)
     write(out, audio)
     return audio

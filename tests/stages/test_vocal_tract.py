@@ -155,3 +155,43 @@ def test_a_schedule_s_tract_entries_are_validated():
                 {"at_ms": -5, "lip_length_cm": 1.0}, {"at_ms": 0, "lip_size": 1.0}):
         with pytest.raises(ArticError, match="tract"):
             parse_schedule({"tract": [bad]}, "s.yaml")
+
+
+def test_the_acoustics_of_tracts_match_their_tubes_and_follow_the_velum(work, rest):
+    from artic_cli.stages.acoustics import read as read_acoustics
+    from artic_cli.stages.acoustics import tract_acoustics, tube_acoustics
+
+    path = work / "rest.h5"
+    frames = tract_acoustics(path, CONFIG, out=work / "rest_ac.h5")
+    tube = tube_acoustics(vts.write_csv(work / "rest_tube.csv", rest, 0), CONFIG)
+    f1, f2, f3 = frames.formants_hz[0, :3]
+    assert 300 < f1 < f2 < f3 < 3500
+    # the same tube: the only difference is where the nasal branch would join (closed here)
+    np.testing.assert_allclose(frames.formants_hz[0], tube.formants_hz[0], rtol=1e-6)
+    back = read_acoustics(work / "rest_ac.h5")
+    assert back.formants_hz.shape == (1, 5) and back.time_s is not None
+    nasal = tract_acoustics(path, CONFIG, velum_area_cm2=0.5)
+    assert abs(nasal.formants_hz[0, 0] - f1) > 10.0  # an open port couples the nasal tract
+    with pytest.raises(ArticError, match="out of range"):
+        tract_acoustics(path, CONFIG, frame=3)
+
+
+def test_the_sound_of_a_closing_tract_falls_silent(work, mesh_file, dorsum_sim):
+    from scipy.io import wavfile
+
+    from artic_cli.stages.synthesize import synthesize_tracts
+
+    tracts = work / "dorsum_vt.h5"
+    vts.vocal_tract(sim=dorsum_sim, mesh=mesh_file, config=CONFIG, out=tracts)
+    a = synthesize_tracts(tracts, work / "dorsum.wav", 115.0, config=CONFIG)
+    fs, y = wavfile.read(work / "dorsum.wav")
+    assert fs == 44100 and len(y) == pytest.approx(0.3 * fs, abs=2)
+    assert np.isfinite(a.samples).all()
+    y = y.astype(float)
+    rms = lambda t0, t1: np.sqrt(np.mean(y[int(t0 * fs):int(t1 * fs)] ** 2))  # noqa: E731
+    assert rms(0.15, 0.29) < 0.3 * rms(0.01, 0.04)  # closed from about 60 ms on: the sound falls by > 10 dB
+    noisy = synthesize_tracts(tracts, work / "noisy.wav", 115.0, config=CONFIG, aspiration=0.5)
+    assert not np.allclose(noisy.samples, a.samples)
+    with pytest.raises(ArticError, match="--aspiration"):
+        synthesize_tracts(tracts, work / "bad.wav", 115.0, config=CONFIG, aspiration=-1.0)
+    assert not (work / "bad.wav").exists()
