@@ -43,6 +43,15 @@ def main() -> None:
     tr_time = _median(tracks, n=3)
     print(f"formant tracks (F1-F5 with bandwidths), 200 frames: {tr_time:.2f} s "
           f"(goal <= 1 s: {'met' if tr_time <= 1.0 else 'NOT met'})")
+    from artic_cli.stages.synthesize import compute_frames
+
+    cfg = load_config()
+    lengths = np.stack([t.length_cm for t in tubes])
+    areas = np.stack([t.area_cm2 for t in tubes])
+    times = np.linspace(0.0, 1.0, 200)
+    compute_frames(lengths[:2], areas[:2], times[:2], cfg, 0.05)  # compile (or load) the line
+    syn = _median(lambda: compute_frames(lengths, areas, times, cfg, 1.0), n=3)
+    print(f"1 s of audio (44.1 kHz) from 200 frames: {syn:.2f} s (goal <= 1 s: {'met' if syn <= 1.0 else 'NOT met'})")
     try:
         import vocaltractlab_cython as vtl
     except ImportError:

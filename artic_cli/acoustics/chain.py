@@ -18,6 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..mechanics.kernels import njit
+
 MIN_AREA_CM2 = 1e-4  # a closure: 0.01 mm^2 keeps the matrices finite (the flow through it is negligible)
 
 
@@ -76,9 +78,54 @@ def section_matrices(length_cm: np.ndarray, area_cm2: np.ndarray, w: np.ndarray,
     return k
 
 
+@njit(cache=True)
+def _chain_kernel(length, area, w, c, rho, mu, kappa, cp, eta, wall_m, wall_r, wall_k, viscous, heat, walls
+                  ):  # pragma: no cover - compiled; the same numbers as section_matrices (a test compares)
+    nf, n = w.shape[0], length.shape[0]
+    out = np.empty((nf, 4), dtype=np.complex128)
+    rc2 = rho * c * c
+    visc = np.sqrt(rho * mu / 2.0)
+    cond = (eta - 1.0) / rc2 * np.sqrt(kappa / (2.0 * cp * rho))
+    for i in range(nf):
+        wi = w[i]
+        sw = np.sqrt(wi)
+        wall = 1.0 / (wall_r + 1j * (wi * wall_m - wall_k / wi)) if walls else 0j
+        a_, b_, c_, d_ = 1.0 + 0j, 0j, 0j, 1.0 + 0j
+        for k in range(n):
+            ak = area[k] if area[k] > MIN_AREA_CM2 else MIN_AREA_CM2
+            perim = 2.0 * np.sqrt(np.pi * ak)
+            z = 1j * wi * rho / ak
+            y = 1j * wi * ak / rc2
+            if viscous:
+                z += perim / (ak * ak) * visc * sw
+            if heat:
+                y += perim * cond * sw
+            y += perim * wall
+            root = np.sqrt(z * y)  # the propagation constant per cm
+            g = root * length[k]
+            z0 = z / root  # sqrt(z / y)
+            e = np.exp(g)
+            ei = 1.0 / e
+            ch = 0.5 * (e + ei)
+            sh = 0.5 * (e - ei)
+            x, yy, zz = ch, z0 * sh, sh / z0
+            a_, b_, c_, d_ = a_ * x + b_ * zz, a_ * yy + b_ * x, c_ * x + d_ * zz, c_ * yy + d_ * x
+        out[i, 0], out[i, 1], out[i, 2], out[i, 3] = a_, b_, c_, d_
+    return out
+
+
 def chain(length_cm: np.ndarray, area_cm2: np.ndarray, w: np.ndarray, air: Air) -> np.ndarray:
-    """(F, 2, 2) product of the sections' matrices, first section first (the four entries multiplied as
-    arrays over frequencies: no per-frequency 2x2 products)."""
+    """(F, 2, 2) product of the sections' matrices, first section first (a compiled loop over frequencies
+    and sections)."""
+    k = _chain_kernel(np.ascontiguousarray(length_cm, dtype=float), np.ascontiguousarray(area_cm2, dtype=float),
+                      np.ascontiguousarray(w, dtype=float), air.c, air.rho, air.mu, air.kappa, air.cp, air.eta,
+                      air.wall_mass, air.wall_resistance, air.wall_stiffness, air.viscous, air.heat, air.walls)
+    return k.reshape(-1, 2, 2)
+
+
+def chain_numpy(length_cm: np.ndarray, area_cm2: np.ndarray, w: np.ndarray, air: Air) -> np.ndarray:
+    """The same product in numpy (four entries multiplied as arrays over frequencies): the reference the
+    compiled :func:`chain` is tested against."""
     ch, bb, cc = _line_parameters(length_cm, area_cm2, w, air)
     a, b, c, d = ch[0], bb[0], cc[0], ch[0]
     for k in range(1, ch.shape[0]):

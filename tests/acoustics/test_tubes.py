@@ -110,3 +110,16 @@ def test_bad_tubes_are_one_line_and_write_nothing(tmp_path, text, needle):
     assert not (tmp_path / "a.h5").exists()
     res = CliRunner().invoke(app, ["acoustics", "--tube", str(tmp_path / "none.csv")])
     assert res.exit_code == 2 and "not found" in res.output
+
+
+@pytest.mark.parametrize("losses", [dict(), dict(viscous=False, heat=False, walls=False)])
+def test_the_compiled_chain_is_the_numpy_chain(losses):
+    from artic_cli.acoustics.chain import Air, chain, chain_numpy
+
+    air = Air(**losses)
+    rng = np.random.default_rng(3)
+    length, area = np.full(44, 17.5 / 44), rng.uniform(0.0, 6.0, 44)
+    area[7] = 0.0  # a closure
+    w = 2 * np.pi * np.linspace(5.0, 5500.0, 300)
+    a, b = chain(length, area, w, air), chain_numpy(length, area, w, air)
+    np.testing.assert_allclose(a, b, rtol=1e-10, atol=0)
