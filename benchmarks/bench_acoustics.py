@@ -38,7 +38,7 @@ def main() -> None:
     def tracks():
         for t in tubes:
             tr = tract_of(t, ac)
-            formants(lambda x, tr=tr: np.abs(transfer(tr, x, air)), ac.max_frequency_hz, ac.frequency_step_hz)
+            formants(lambda x, tr=tr: np.abs(transfer(tr, x, air)), ac.max_frequency_hz, ac.formant_search_step_hz)
 
     tr_time = _median(tracks, n=3)
     print(f"formant tracks (F1-F5 with bandwidths), 200 frames: {tr_time:.2f} s "

@@ -18,7 +18,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..mechanics.kernels import njit
+from ..mechanics.kernels import AVAILABLE, njit
+
+if AVAILABLE:  # pragma: no cover - numba is a dependency
+    from numba import prange
+else:  # pragma: no cover
+    prange = range
 
 MIN_AREA_CM2 = 1e-4  # a closure: 0.01 mm^2 keeps the matrices finite (the flow through it is negligible)
 
@@ -78,33 +83,34 @@ def section_matrices(length_cm: np.ndarray, area_cm2: np.ndarray, w: np.ndarray,
     return k
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True)
 def _chain_kernel(length, area, w, c, rho, mu, kappa, cp, eta, wall_m, wall_r, wall_k, viscous, heat, walls
                   ):  # pragma: no cover - compiled; the same numbers as section_matrices (a test compares)
     nf, n = w.shape[0], length.shape[0]
     out = np.empty((nf, 4), dtype=np.complex128)
     rc2 = rho * c * c
-    visc = np.sqrt(rho * mu / 2.0)
-    cond = (eta - 1.0) / rc2 * np.sqrt(kappa / (2.0 * cp * rho))
-    for i in range(nf):
+    visc = np.sqrt(rho * mu / 2.0) if viscous else 0.0
+    cond = (eta - 1.0) / rc2 * np.sqrt(kappa / (2.0 * cp * rho)) if heat else 0.0
+    # what depends on the section only: inertance, compliance, and the loss terms' area factors
+    inert, compl, z_loss, y_loss, perim = (np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n))
+    for k in range(n):
+        ak = area[k] if area[k] > MIN_AREA_CM2 else MIN_AREA_CM2
+        perim[k] = 2.0 * np.sqrt(np.pi * ak)
+        inert[k] = rho / ak
+        compl[k] = ak / rc2
+        z_loss[k] = perim[k] / (ak * ak) * visc
+        y_loss[k] = perim[k] * cond
+    for i in prange(nf):
         wi = w[i]
         sw = np.sqrt(wi)
         wall = 1.0 / (wall_r + 1j * (wi * wall_m - wall_k / wi)) if walls else 0j
         a_, b_, c_, d_ = 1.0 + 0j, 0j, 0j, 1.0 + 0j
         for k in range(n):
-            ak = area[k] if area[k] > MIN_AREA_CM2 else MIN_AREA_CM2
-            perim = 2.0 * np.sqrt(np.pi * ak)
-            z = 1j * wi * rho / ak
-            y = 1j * wi * ak / rc2
-            if viscous:
-                z += perim / (ak * ak) * visc * sw
-            if heat:
-                y += perim * cond * sw
-            y += perim * wall
+            z = z_loss[k] * sw + 1j * wi * inert[k]
+            y = y_loss[k] * sw + 1j * wi * compl[k] + perim[k] * wall
             root = np.sqrt(z * y)  # the propagation constant per cm
-            g = root * length[k]
             z0 = z / root  # sqrt(z / y)
-            e = np.exp(g)
+            e = np.exp(root * length[k])
             ei = 1.0 / e
             ch = 0.5 * (e + ei)
             sh = 0.5 * (e - ei)

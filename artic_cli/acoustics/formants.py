@@ -77,10 +77,11 @@ def formants(magnitude: Callable[[np.ndarray], np.ndarray], f_max_hz: float = 55
     ok_l, ok_r = np.isfinite(left), np.isfinite(right)
     lx = np.full(len(peaks), np.nan)
     rx = np.full(len(peaks), np.nan)
-    if ok_l.any():
-        lx[ok_l] = _crossing(magnitude, left[ok_l], np.minimum(left[ok_l] + step_hz, fp[ok_l]), half[ok_l])
-    if ok_r.any():
-        rx[ok_r] = _crossing(magnitude, np.maximum(right[ok_r] - step_hz, fp[ok_r]), right[ok_r], half[ok_r])
+    if ok_l.any() or ok_r.any():  # both sides' crossings in one search (one evaluation per round)
+        lo = np.concatenate([left[ok_l], np.maximum(right[ok_r] - step_hz, fp[ok_r])])
+        hi = np.concatenate([np.minimum(left[ok_l] + step_hz, fp[ok_l]), right[ok_r]])
+        x = _crossing(magnitude, lo, hi, np.concatenate([half[ok_l], half[ok_r]]))
+        lx[ok_l], rx[ok_r] = x[:ok_l.sum()], x[ok_l.sum():]
     width = np.where(ok_l & ok_r, rx - lx, np.where(ok_l, 2 * (fp - lx), 2 * (rx - fp)))
     freq[: len(peaks)] = fp
     bw[: len(peaks)] = width

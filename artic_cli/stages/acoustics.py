@@ -56,7 +56,7 @@ def compute(tubes: list[Tube], cfg: Config, lossless: bool = False, velum_area_c
         tf.append(20 * np.log10(np.maximum(np.abs(h), 1e-12)))
         pr.append(20 * np.log10(np.maximum(np.abs(radiated_pressure(h, f, air)), 1e-30) / 2e-4))
         fk, bk = formants(lambda x, t=tract: np.abs(transfer(t, x, air)), ac.max_frequency_hz,
-                          ac.frequency_step_hz, ac.formants, lossless=lossless)
+                          ac.formant_search_step_hz, ac.formants, lossless=lossless)
         fm.append(fk)
         bw.append(bk)
     if progress is not None:
