@@ -40,7 +40,11 @@ def tract_of(tube: Tube, ac, velum_area_cm2: float | None = None, lossless: bool
     if nt.enabled and velum > 0:
         at = tube.total_length_cm - nt.port_from_lips_cm if port_from_glottis_cm is None else port_from_glottis_cm
         nasal = Tube(np.array([nt.port_length_cm, *nt.lengths_cm]), np.array([velum, *nt.areas_cm2]))
-        branches.append(Branch(max(at, 0.0), nasal, radiating=True))
+        sinuses = tuple(Branch(nt.port_length_cm + s.at_cm,
+                               Tube(np.array([s.neck_length_cm, nt.sinus_cavity_length_cm]),
+                                    np.array([s.neck_area_cm2, s.volume_cm3 / nt.sinus_cavity_length_cm])))
+                        for s in nt.sinuses) if nt.sinuses_enabled else ()
+        branches.append(Branch(max(at, 0.0), nasal, radiating=True, branches=sinuses))
     return Tract(tube, branches)
 
 

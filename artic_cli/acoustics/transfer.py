@@ -24,6 +24,7 @@ class Branch:
     tube: Tube
     radiating: bool = False
     count: int = 1
+    branches: tuple = ()  # its own side branches (the paranasal sinuses on the nasal tract), at_cm along it
 
 
 @dataclass
@@ -33,7 +34,8 @@ class Tract:
 
 
 def _branch_admittance(b: Branch, w: np.ndarray, air: Air) -> np.ndarray:
-    k = chain(b.tube.length_cm, b.tube.area_cm2, w, air)
+    k = tract_chain(Tract(b.tube, list(b.branches)), w, air) if b.branches else \
+        chain(b.tube.length_cm, b.tube.area_cm2, w, air)
     load = radiation_impedance(b.tube.area_cm2[-1], w, air) if b.radiating else None
     return b.count / input_impedance(k, load)
 

@@ -123,3 +123,16 @@ def test_the_compiled_chain_is_the_numpy_chain(losses):
     w = 2 * np.pi * np.linspace(5.0, 5500.0, 300)
     a, b = chain(length, area, w, air), chain_numpy(length, area, w, air)
     np.testing.assert_allclose(a, b, rtol=1e-10, atol=0)
+
+
+def test_opening_the_velum_lowers_f1_and_the_sinuses_act_only_through_it():
+    ac = load_config().acoustics
+    air, tube = air_of(ac), uniform(17.5, 4.0)
+    closed, _ = _formants(tract_of(tube, ac, 0.0), air)
+    nasal, _ = _formants(tract_of(tube, ac, 0.5), air)
+    assert nasal[0] <= 0.95 * closed[0]  # the issue's figure: at least 5 % lower
+    no_sinus = ac.model_copy(update={"nasal": ac.nasal.model_copy(update={"sinuses_enabled": False})})
+    shut, _ = _formants(tract_of(tube, no_sinus, 0.0), air)
+    np.testing.assert_array_equal(shut, closed)  # the velum closed: the sinuses change nothing
+    plain, _ = _formants(tract_of(tube, no_sinus, 0.5), air)
+    assert plain[0] > nasal[0]  # the lowering is the sinuses' (without them the port raises the first peak)
