@@ -95,6 +95,7 @@ def render(p: Pipeline) -> str:
             stamp = f"$(OUT)/.stamps/{st.name}/{name or st.name}"
             ok = " || [ $$? -eq 3 ]" if 3 in st.ok_status else ""
             lines += [f"{stamp}: {inputs} {' '.join(sections)} {src} | setup".replace("  ", " "),
+                      f"\t@mkdir -p $(dir {output})",
                       f"\t$(ARTIC) {_fill(st.command, **kw)}{ok}",
                       "\t@mkdir -p $(@D) && touch $@",
                       f"{output}: {stamp} ; @test -f $@ || {{ rm -f $<; $(MAKE) --no-print-directory $< OUT=$(OUT) "

@@ -386,6 +386,43 @@ def plot_vocal_tract_cmd(
         out_console.print(f"wrote {animate_tracts(t, animate)}", highlight=False)
 
 
+@plot_app.command("acoustics")
+@handle_errors
+def plot_acoustics_cmd(
+    result: Path = typer.Argument(..., help="Result of 'artic acoustics --out'."),
+    out: Path = typer.Option(..., "--out", help="The transfer function with its formants, or for several frames "
+                                                "the formant tracks (PNG)."),
+    frame: Optional[int] = typer.Option(None, "--frame", help="Draw this frame's transfer function instead."),
+):
+    """The transfer function with the formants marked, or the formant tracks of a time series."""
+    from ..plots.acoustics import plot_tracks, plot_transfer
+    from ..stages.acoustics import read
+
+    r = read(result)
+    n = len(r.formants_hz)
+    if frame is not None and not -n <= frame < n:
+        raise ArticError(f"--frame {frame} is out of range: the file has {n} frames (0 to {n - 1}); give one of them")
+    if n > 1 and frame is None:
+        path = plot_tracks(r, out, title=f"{result.stem}: formant tracks")
+    else:
+        path = plot_transfer(r, 0 if frame is None else frame % n, out, title=result.stem)
+    out_console.print(f"wrote {path}", highlight=False)
+
+
+@plot_app.command("audio")
+@handle_errors
+def plot_audio_cmd(
+    wav: Path = typer.Argument(..., help="A WAV file (from 'artic synthesize')."),
+    out: Path = typer.Option(..., "--out", help="Its spectrogram (PNG)."),
+):
+    """The spectrogram of a sound."""
+    from ..plots.acoustics import plot_spectrogram
+    from ..stages.synthesize import read_wav
+
+    samples, rate = read_wav(wav)
+    out_console.print(f"wrote {plot_spectrogram(samples, rate, out, title=wav.name)}", highlight=False)
+
+
 @app.command("dynamic-map")
 @handle_errors
 def dynamic_map_cmd(

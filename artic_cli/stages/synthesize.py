@@ -97,6 +97,23 @@ def write(path: Path | str, audio: Audio) -> Path:
     return path
 
 
+def read_wav(path: Path | str) -> tuple[np.ndarray, int]:
+    """Samples (float, -1..1, the first channel) and the rate of a WAV file; a missing or damaged file is
+    one error naming the fix."""
+    path = Path(path)
+    if not path.is_file():
+        raise ArticError(f"WAV file not found: {path}; give an existing file (rerun 'artic synthesize')")
+    try:
+        rate, data = wavfile.read(path)
+    except (ValueError, OSError, EOFError):
+        raise ArticError(f"{path} is not a readable WAV file (corrupted or truncated); rerun 'artic synthesize'") from None
+    data = np.asarray(data)
+    if data.ndim > 1:
+        data = data[:, 0]
+    scale = float(np.iinfo(data.dtype).max) if np.issubdtype(data.dtype, np.integer) else 1.0
+    return data.astype(float) / scale, int(rate)
+
+
 class F0Point(Strict):
     time_s: NonNegative
     f0_hz: F0Hz

@@ -8,6 +8,7 @@ import shutil
 import subprocess
 
 import h5py
+import numpy as np
 import pytest
 
 from conftest import ROOT
@@ -121,6 +122,15 @@ def test_the_tracts_of_the_pipeline_and_of_one_ep(built, tmp_path):
         t = vts.read(built / "tracts" / f"{name}.h5")
         with h5py.File(built / "sims" / f"{name}.h5", "r") as f:
             assert t.n_frames == f["time"].shape[0]
+    from artic_cli.stages.acoustics import read as read_acoustics
+    from artic_cli.stages.synthesize import read_wav
+
+    for name in ("rest", "fig4_ggp", "fig4_sg", "art_sg_jo"):
+        ac = read_acoustics(built / "acoustics" / f"{name}.h5")
+        assert ac.formants_hz.shape[1] == 5 and np.isfinite(ac.formants_hz[:, :3]).all()
+    samples, rate = read_wav(built / "audio" / "rest.wav")
+    assert rate == 44100 and len(samples) == 44100 and np.abs(samples).max() > 0.5
+    assert "audio/rest.wav" in (built / "reports" / "paper.md").read_text()
     cfg = ROOT / "configs" / "ci_thin.yaml"
     ep = vts.vocal_tract(ep="JO_0.5:SG=4", epmaps=built / "epmaps.h5", mesh=built / "mesh.h5", config=cfg,
                          out=tmp_path / "ep.h5").tracts
