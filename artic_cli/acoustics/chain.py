@@ -83,8 +83,7 @@ def section_matrices(length_cm: np.ndarray, area_cm2: np.ndarray, w: np.ndarray,
     return k
 
 
-@njit(cache=True, parallel=True)
-def _chain_kernel(length, area, w, c, rho, mu, kappa, cp, eta, wall_m, wall_r, wall_k, viscous, heat, walls
+def _chain_loop(length, area, w, c, rho, mu, kappa, cp, eta, wall_m, wall_r, wall_k, viscous, heat, walls
                   ):  # pragma: no cover - compiled; the same numbers as section_matrices (a test compares)
     nf, n = w.shape[0], length.shape[0]
     out = np.empty((nf, 4), dtype=np.complex128)
@@ -120,10 +119,16 @@ def _chain_kernel(length, area, w, c, rho, mu, kappa, cp, eta, wall_m, wall_r, w
     return out
 
 
+_chain_serial = njit(cache=True)(_chain_loop)
+_chain_parallel = njit(cache=True, parallel=True)(_chain_loop)
+PARALLEL_FROM = 256  # frequencies; below this, starting the threads costs more than they save
+
+
 def chain(length_cm: np.ndarray, area_cm2: np.ndarray, w: np.ndarray, air: Air) -> np.ndarray:
     """(F, 2, 2) product of the sections' matrices, first section first (a compiled loop over frequencies
-    and sections)."""
-    k = _chain_kernel(np.ascontiguousarray(length_cm, dtype=float), np.ascontiguousarray(area_cm2, dtype=float),
+    and sections, threaded over frequencies for long spectra)."""
+    kernel = _chain_parallel if np.size(w) >= PARALLEL_FROM else _chain_serial
+    k = kernel(np.ascontiguousarray(length_cm, dtype=float), np.ascontiguousarray(area_cm2, dtype=float),
                       np.ascontiguousarray(w, dtype=float), air.c, air.rho, air.mu, air.kappa, air.cp, air.eta,
                       air.wall_mass, air.wall_resistance, air.wall_stiffness, air.viscous, air.heat, air.walls)
     return k.reshape(-1, 2, 2)

@@ -17,9 +17,11 @@ ROUNDS = 3
 POINTS = 8
 
 
-def _zoom_peaks(magnitude: Callable[[np.ndarray], np.ndarray], centre: np.ndarray, half: float) -> np.ndarray:
+def _zoom_peaks(magnitude: Callable[[np.ndarray], np.ndarray], centre: np.ndarray, half: float,
+                rounds: int = ROUNDS) -> tuple[np.ndarray, np.ndarray]:
+    """Each peak's frequency and its height (|H|, from the parabola through the last three points)."""
     lo, hi = centre - half, centre + half
-    for _ in range(ROUNDS):
+    for _ in range(rounds):
         grid = np.linspace(lo, hi, POINTS + 1, axis=-1)  # (P, 9)
         m = magnitude(grid.ravel()).reshape(grid.shape)
         k = np.clip(np.argmax(m, axis=1), 1, POINTS - 1)
@@ -29,8 +31,10 @@ def _zoom_peaks(magnitude: Callable[[np.ndarray], np.ndarray], centre: np.ndarra
     m = 20 * np.log10(magnitude(grid.ravel()).reshape(grid.shape))
     a, b, c = m[:, 0], m[:, 1], m[:, 2]
     den = a - 2 * b + c
-    shift = np.where(den < 0, 0.5 * (a - c) / np.where(den < 0, den, -1.0), 0.0)
-    return grid[:, 1] + shift * (grid[:, 2] - grid[:, 1])
+    safe = np.where(den < 0, den, -1.0)
+    shift = np.where(den < 0, 0.5 * (a - c) / safe, 0.0)
+    top_db = np.where(den < 0, b - 0.125 * (a - c) ** 2 / safe, b)
+    return grid[:, 1] + shift * (grid[:, 2] - grid[:, 1]), 10.0 ** (top_db / 20.0)
 
 
 def _crossing(magnitude, lo: np.ndarray, hi: np.ndarray, level: np.ndarray) -> np.ndarray:
@@ -60,12 +64,13 @@ def formants(magnitude: Callable[[np.ndarray], np.ndarray], f_max_hz: float = 55
     bw = np.full(count, np.nan)
     if len(peaks) == 0:
         return freq, bw
-    fp = _zoom_peaks(magnitude, f[peaks], step_hz)
+    # a lossy peak is smooth: two zoom rounds leave a bracket of step / 16 where the parabola is exact to far
+    # below a hertz; a lossless one (a pole on the axis) gets a third
+    fp, top = _zoom_peaks(magnitude, f[peaks], step_hz, ROUNDS if lossless else ROUNDS - 1)
     if lossless:
         freq[: len(peaks)] = fp
         bw[: len(peaks)] = 0.0
         return freq, bw
-    top = magnitude(fp)
     half = top / np.sqrt(2.0)
     left = np.empty(len(peaks))
     right = np.empty(len(peaks))

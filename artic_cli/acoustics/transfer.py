@@ -31,6 +31,16 @@ class Branch:
 class Tract:
     tube: Tube
     branches: list[Branch] = field(default_factory=list)
+    _plan: tuple | None = field(default=None, init=False, repr=False, compare=False)  # split tube, cuts
+
+    def plan(self) -> tuple:
+        """The tube cut at the branches' junctions and where each branch joins (computed once)."""
+        if self._plan is None:
+            t = split_at(self.tube, [b.at_cm for b in self.branches])
+            edges = np.concatenate([[0.0], np.cumsum(t.length_cm)])
+            cut = sorted((int(np.argmin(np.abs(edges - b.at_cm))), j) for j, b in enumerate(self.branches))
+            self._plan = (t, cut)
+        return self._plan
 
 
 def _branch_admittance(b: Branch, w: np.ndarray, air: Air) -> np.ndarray:
@@ -55,9 +65,7 @@ def split_at(tube: Tube, points_cm) -> Tube:
 
 def tract_chain(tract: Tract, w: np.ndarray, air: Air) -> np.ndarray:
     """(F, 2, 2) glottis-to-lips chain matrix with the branches' shunts."""
-    t = split_at(tract.tube, [b.at_cm for b in tract.branches])
-    edges = np.concatenate([[0.0], np.cumsum(t.length_cm)])
-    cut = sorted((int(np.argmin(np.abs(edges - b.at_cm))), j) for j, b in enumerate(tract.branches))
+    t, cut = tract.plan()
     total = None
     start = 0
     for idx, j in cut + [(len(t.length_cm), None)]:
