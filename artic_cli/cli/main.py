@@ -423,6 +423,46 @@ def plot_audio_cmd(
     out_console.print(f"wrote {plot_spectrogram(samples, rate, out, title=wav.name)}", highlight=False)
 
 
+@app.command("acoustic-map")
+@handle_errors
+def acoustic_map_cmd(
+    maps: Path = typer.Option(Path("data/epmaps.h5"), "--maps", help="EP maps from 'artic ep-map' (with shapes)."),
+    mesh: Path = typer.Option(Path("data/mesh.h5"), "--mesh", help="The mesh the maps were built on."),
+    config: Optional[Path] = typer.Option(None, "--config", help="Config ('vocal_tract' and 'acoustics')."),
+    out: Path = typer.Option(Path("data/acoustic_maps.h5"), "--out", help="Formants and area functions (HDF5)."),
+    plot: Optional[Path] = typer.Option(None, "--plot", help="The vowel space: every EP in the F1-F2 plane (PNG)."),
+    force: bool = typer.Option(False, "--force", help="Recompute even if the file is up to date."),
+):
+    """Every EP's area function and formants F1-F4: the EP maps made acoustic."""
+    from ..stages.acoustic_map import JAPANESE_VOWELS, acoustic_map
+
+    r = _with_progress("EPs", lambda update: acoustic_map(maps, mesh, config, out, update, force))
+    rows = []
+    for jname in r.maps.jaws:
+        p = r.maps.points(jname)
+        rows.append((jname, str(len(p)), f"{np.nanmin(p[:, 0]):.0f}-{np.nanmax(p[:, 0]):.0f}",
+                     f"{np.nanmin(p[:, 1]):.0f}-{np.nanmax(p[:, 1]):.0f}"))
+    _print_table("the EP maps' formants", ("jaw", "EPs", "F1 Hz", "F2 Hz"), rows, left=("jaw",))
+    if plot is not None:
+        from ..plots.acoustic_map import plot_vowel_space
+
+        out_console.print(f"wrote {plot_vowel_space(r.maps, plot, JAPANESE_VOWELS)}", highlight=False)
+    out_console.print(f"{'up to date' if r.up_to_date else 'wrote'} {r.path}", highlight=False)
+
+
+@plot_app.command("acoustic-map")
+@handle_errors
+def plot_acoustic_map_cmd(
+    result: Path = typer.Argument(Path("data/acoustic_maps.h5"), help="Result of 'artic acoustic-map'."),
+    out: Path = typer.Option(..., "--out", help="The vowel space (PNG)."),
+):
+    """Every EP in the F1-F2 plane, jaw position by jaw position, with the Japanese vowels."""
+    from ..plots.acoustic_map import plot_vowel_space
+    from ..stages.acoustic_map import JAPANESE_VOWELS, read
+
+    out_console.print(f"wrote {plot_vowel_space(read(result), out, JAPANESE_VOWELS)}", highlight=False)
+
+
 @app.command("dynamic-map")
 @handle_errors
 def dynamic_map_cmd(

@@ -108,6 +108,7 @@ class Net:
     x: np.ndarray  # (*grid, 3, 3)
     converged: np.ndarray  # (*grid,)
     drift_cm: np.ndarray  # (*grid,)
+    shapes: np.ndarray | None = None  # (*grid, N, 3) every node at each EP, cm (float32)
 
 
 @dataclass
@@ -118,6 +119,7 @@ class JawMaps:
     pair: dict[str, Net] = field(default_factory=dict)
     group: dict[str, Net] = field(default_factory=dict)
     mandible: np.ndarray | None = None  # (K, 3) the mandible's nodes at this jaw position's rest, cm
+    rest_shape: np.ndarray | None = None  # (N, 3) every node at this jaw position's rest, cm
 
 
 @dataclass
@@ -125,6 +127,8 @@ class EPMaps:
     jaws: dict[str, JawMaps]
     typical_jaw: str
     attrs: dict = field(default_factory=dict)
+    model_rest: np.ndarray | None = None  # (N, 3) the model's rest (bones' motions are measured from it), cm
+    mandible_nodes: np.ndarray | None = None  # node indices of the mandible
 
     def unconverged(self) -> list[str]:
         out = []
@@ -138,31 +142,38 @@ class EPMaps:
 
 
 def assemble(spec: EPMapSpec, rests: dict[str, np.ndarray], eps: dict,
-             mandibles: dict[str, np.ndarray] | None = None) -> EPMaps:
+             mandibles: dict[str, np.ndarray] | None = None, rest_shapes: dict[str, np.ndarray] | None = None
+             ) -> EPMaps:
     def get(jaw: str, forces: dict[str, float]):
         key = canonical(forces)
         if not key:
-            return rests[jaw], 0.0, True
+            return rests[jaw], 0.0, True, None if rest_shapes is None else rest_shapes[jaw]
         r = eps[(jaw, key)]
-        return r["x"], r["drift_cm"], r["converged"]
+        return r["x"], r["drift_cm"], r["converged"], r.get("shape")
 
     def net(jaw: str, muscles: tuple[str, ...], levels: tuple) -> Net:
         shape = tuple(len(lv) for lv in levels)
         x = np.zeros(shape + (3, 3))
         conv = np.zeros(shape, dtype=bool)
         drift = np.zeros(shape)
+        shapes = None
         for idx in np.ndindex(*shape):
-            xi, d, c = get(jaw, add_forces(*({m: lv[i]} for m, lv, i in zip(muscles, levels, idx))))
+            xi, d, c, sh = get(jaw, add_forces(*({m: lv[i]} for m, lv, i in zip(muscles, levels, idx))))
             x[idx], drift[idx], conv[idx] = xi, d, c
+            if sh is not None:
+                if shapes is None:
+                    shapes = np.zeros(shape + sh.shape, dtype=np.float32)
+                shapes[idx] = sh
         return Net(muscles=muscles, levels=tuple(np.asarray(lv, dtype=float) for lv in levels), x=x,
-                   converged=conv, drift_cm=drift)
+                   converged=conv, drift_cm=drift, shapes=shapes)
 
     jaws = {}
     grid = [0.0, *spec.pair_levels_n]
     for jaw, jf in spec.jaw_positions.items():
         jm = JawMaps(forces=dict(jf), rest=rests[jaw],
                      single={m: net(jaw, (m,), (spec.levels_n,)) for m in spec.muscles},
-                     mandible=None if mandibles is None else mandibles[jaw])
+                     mandible=None if mandibles is None else mandibles[jaw],
+                     rest_shape=None if rest_shapes is None else rest_shapes[jaw])
         if jaw in spec.net_jaw_positions:
             for a, b in pairs(spec):
                 jm.pair[f"{a}+{b}"] = net(jaw, (a, b), (grid, grid))

@@ -1,5 +1,5 @@
 """One equilibrium position (EP): hold a set of muscle forces from a jaw position's rest and read where the
-tongue tip, the dorsum and the jaw come to rest (the paper's section IV.B).
+tongue tip, the dorsum and the jaw come to rest (the paper's section IV.B), and the whole shape.
 
 Pure physics over a model: no maps, no files.  The worker functions at the bottom build the model once per
 process (they travel to loky or dask workers) and are what the EP-map sweep caches.
@@ -106,14 +106,17 @@ def compute_ep(key: str, jaw_forces: Forces, forces: Forces, spec_json: str, fas
     model = worker_model(key, cfg_json, mesh, wall)
     spec = EPMapSpec.model_validate(json.loads(spec_json))
     start = worker_rest(key, jaw_forces, cfg_json, mesh, wall)
-    ep = equilibrium_point(model, start, add_forces(dict(jaw_forces), dict(forces)), spec, fast)
-    return {"x": ep.x, "drift_cm": ep.drift_cm, "converged": ep.converged, "stopped_ms": ep.stopped_ms}
+    state, ep = equilibrium_state(model, start, add_forces(dict(jaw_forces), dict(forces)), spec, fast)
+    return {"x": ep.x, "drift_cm": ep.drift_cm, "converged": ep.converged, "stopped_ms": ep.stopped_ms,
+            "shape": state.x.astype(np.float32)}
 
 
 def compute_rest(key: str, jaw_forces: Forces, cfg_json: str, mesh: Mesh, wall: WallSurface) -> dict:
     model = worker_model(key, cfg_json, mesh, wall)
     st = worker_rest(key, jaw_forces, cfg_json, mesh, wall)
-    return {"x": st.x[watch_nodes(model)].copy(), "mandible": st.x[model.node_sets["mandible"]].copy()}
+    return {"x": st.x[watch_nodes(model)].copy(), "mandible": st.x[model.node_sets["mandible"]].copy(),
+            "shape": st.x.astype(np.float32), "model_rest": model.rest.copy(),
+            "mandible_nodes": np.asarray(model.node_sets["mandible"])}
 
 
 def spec_key(spec: EPMapSpec) -> str:

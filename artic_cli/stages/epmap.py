@@ -74,7 +74,10 @@ def compute(cfg: Config, mesh, wall, mesh_sha: str, sweep: Sweep, fast: bool = F
     rests = {j: res.results[k]["x"] for k, j in enumerate(jaws)}
     mandibles = {j: res.results[k]["mandible"] for k, j in enumerate(jaws)}
     eps = {(t.jaw, t.forces): res.results[len(jaws) + k] for k, t in enumerate(tasks)}
-    return assemble(spec, rests, eps, mandibles), res.cached
+    maps = assemble(spec, rests, eps, mandibles, {j: res.results[k]["shape"] for k, j in enumerate(jaws)})
+    maps.model_rest = res.results[0]["model_rest"]
+    maps.mandible_nodes = res.results[0]["mandible_nodes"]
+    return maps, res.cached
 
 
 def _call(what: str, key: str, jaw_forces, forces, spec_json: str, fast: bool, cfg_json: str, mesh, wall) -> dict:
@@ -119,6 +122,9 @@ def write(path: Path | str, maps: EPMaps, cfg: Config, prov=None, fast: bool = F
                         "layout": "jaw_positions/<jaw>/{rest, single/<muscle>, pair/<a+b>, group/<i+a+b>}: "
                                   "force_<k>_n per axis; tip, dorsum, jaw (*grid, 3) in cm; converged; drift_cm"})
         f.attrs["jaw_order"] = list(maps.jaws)
+        if maps.model_rest is not None:
+            f.create_dataset("nodes/rest", data=maps.model_rest).attrs["units"] = "cm (the model's rest)"
+            f.create_dataset("nodes/mandible", data=maps.mandible_nodes).attrs["units"] = "node indices"
         for jname, jm in maps.jaws.items():
             g = f.create_group(f"jaw_positions/{jname}")
             g.attrs["jaw_forces_n"] = json.dumps(jm.forces)
@@ -129,6 +135,8 @@ def write(path: Path | str, maps: EPMaps, cfg: Config, prov=None, fast: bool = F
                 r.create_dataset(cp, data=jm.rest[c]).attrs["units"] = "cm"
             if jm.mandible is not None:
                 r.create_dataset("mandible", data=jm.mandible).attrs["units"] = "cm (the mandible's nodes)"
+            if jm.rest_shape is not None:
+                r.create_dataset("shape", data=jm.rest_shape, compression="gzip").attrs["units"] = "cm (every node)"
             for fam in ("single", "pair", "group"):
                 for name, net in getattr(jm, fam).items():
                     n = g.create_group(f"{fam}/{name}")
@@ -139,6 +147,9 @@ def write(path: Path | str, maps: EPMaps, cfg: Config, prov=None, fast: bool = F
                     for c, cp in enumerate(CONTROL_POINTS):
                         n.create_dataset(cp, data=net.x[..., c, :]).attrs["units"] = "cm"
                     n.create_dataset("converged", data=net.converged)
+                    if net.shapes is not None:
+                        n.create_dataset("shape", data=net.shapes, compression="gzip", shuffle=True).attrs["units"] = (
+                            "cm (*grid x nodes x 3: every node at each EP)")
                     n.create_dataset("drift_cm", data=net.drift_cm).attrs["units"] = (
                         f"cm moved over the last {cfg.epmap.convergence_window_ms:g} ms")
 
@@ -158,7 +169,8 @@ def read(path: Path | str = "data/epmaps.h5", mesh: Path | str | None = None) ->
                 g = f["jaw_positions"][jname]
                 rest = np.array([g["rest"][cp][()] for cp in CONTROL_POINTS])
                 jm = JawMaps(forces=json.loads(g.attrs["jaw_forces_n"]), rest=rest, single={},
-                             mandible=g["rest"]["mandible"][()] if "mandible" in g["rest"] else None)
+                             mandible=g["rest"]["mandible"][()] if "mandible" in g["rest"] else None,
+                             rest_shape=g["rest"]["shape"][()] if "shape" in g["rest"] else None)
                 for fam in ("single", "pair", "group"):
                     for name in g.attrs[f"{fam}_order"]:
                         n = g[fam][name]
@@ -166,10 +178,13 @@ def read(path: Path | str = "data/epmaps.h5", mesh: Path | str | None = None) ->
                         levels = tuple(n[f"force_{k}_n"][()] for k in range(len(muscles)))
                         x = np.stack([n[cp][()] for cp in CONTROL_POINTS], axis=-2)
                         getattr(jm, fam)[name] = Net(muscles=muscles, levels=levels, x=x,
-                                                     converged=n["converged"][()], drift_cm=n["drift_cm"][()])
+                                                     converged=n["converged"][()], drift_cm=n["drift_cm"][()],
+                                                     shapes=n["shape"][()] if "shape" in n else None)
                 jaws[jname] = jm
             attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()}
-            return EPMaps(jaws=jaws, typical_jaw=str(f.attrs["typical_jaw"]), attrs=attrs)
+            return EPMaps(jaws=jaws, typical_jaw=str(f.attrs["typical_jaw"]), attrs=attrs,
+                          model_rest=f["nodes/rest"][()] if "nodes" in f else None,
+                          mandible_nodes=f["nodes/mandible"][()] if "nodes" in f else None)
         except (KeyError, ValueError, OSError) as err:
             raise ArticError(f"{path} is damaged or incomplete ({type(err).__name__}); {hint}") from None
 

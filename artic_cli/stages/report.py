@@ -14,7 +14,7 @@ from ..errors import ArticError
 from ..io.store import open_artifact, write_text_atomic
 from .base import Stage
 
-STAGE = Stage(name="report", module=__name__, sections=(), reads=("mesh", "cuboid", "sims", "tracts", "experiments", "musclefunction", "epmaps", "dynamic", "solve"), kind="report", hint="rerun 'artic report' (or 'make paper')")
+STAGE = Stage(name="report", module=__name__, sections=(), reads=("mesh", "cuboid", "sims", "tracts", "acoustics", "acousticmaps", "experiments", "musclefunction", "epmaps", "dynamic", "solve"), kind="report", hint="rerun 'artic report' (or 'make paper')")
 
 
 @dataclass
@@ -303,6 +303,20 @@ def tract_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row], l
                             f"{fm[k]:.0f} Hz ({100 * err:+.0f} %)", _verdict(abs(err) <= 0.10, "within 10 %")))
         lines += ["![The rest tract's transfer function and formants](acoustics_rest.png)",
                   "![The rest tract voiced for 1 s (F0 115 Hz)](spectrogram_rest.png)", ""]
+    amaps = data / "acoustic_maps.h5"
+    if amaps.is_file():
+        from .acoustic_map import JAPANESE_VOWELS
+        from .acoustic_map import read as read_amaps
+
+        am = read_amaps(amaps)
+        pts = np.concatenate([am.points(j)[:, :2] for j in am.jaws])
+        reached = [v for v, (f1, f2) in JAPANESE_VOWELS.items()
+                   if np.any((np.abs(pts[:, 0] / f1 - 1) <= 0.1) & (np.abs(pts[:, 1] / f2 - 1) <= 0.1))]
+        rows.append(Row("EP maps in the F1-F2 plane (every jaw position)", "male Japanese a i u e o",
+                        f"{len(pts)} EPs: F1 {np.nanmin(pts[:, 0]):.0f}-{np.nanmax(pts[:, 0]):.0f} Hz, F2 "
+                        f"{np.nanmin(pts[:, 1]):.0f}-{np.nanmax(pts[:, 1]):.0f} Hz; vowels within 10 %: "
+                        f"{' '.join(reached) or 'none'}", _verdict(len(reached) == 5, "all five within 10 %")))
+        lines += ["![The EP maps' vowel space](vowel_space.png)", ""]
     wav = data / "audio" / "rest.wav"
     if wav.is_file():
         import os

@@ -132,6 +132,18 @@ def test_the_tracts_of_the_pipeline_and_of_one_ep(built, tmp_path):
     samples, rate = read_wav(built / "audio" / "rest.wav")
     assert rate == 44100 and len(samples) == 44100 and np.abs(samples).max() > 0.5
     assert "audio/rest.wav" in (built / "reports" / "paper.md").read_text()
+    # the EP maps keep every EP's shape, and the acoustic maps give each its formants; the rest EP's are the
+    # rest tract's (the shapes are stored in single precision)
+    from artic_cli.stages.acoustic_map import read as read_amaps
+    from artic_cli.stages.epmap import read as read_maps
+
+    maps, am = read_maps(built / "epmaps.h5"), read_amaps(built / "acoustic_maps.h5")
+    for jname, jm in maps.jaws.items():
+        for name, net in jm.single.items():
+            assert net.shapes.shape[:-2] == net.x.shape[:-2]
+            assert am.jaws[jname][f"single/{name}"].formants_hz.shape == net.x.shape[:-2] + (4,)
+    rest_f = read_acoustics(built / "acoustics" / "rest.h5").formants_hz[0, :4]
+    np.testing.assert_allclose(am.jaws["rest"]["rest"].formants_hz.reshape(4), rest_f, rtol=2e-3)
     cfg = ROOT / "configs" / "ci_thin.yaml"
     ep = vts.vocal_tract(ep="JO_0.5:SG=4", epmaps=built / "epmaps.h5", mesh=built / "mesh.h5", config=cfg,
                          out=tmp_path / "ep.h5").tracts

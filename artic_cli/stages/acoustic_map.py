@@ -1,0 +1,140 @@
+"""Stage ``acoustic-map``: the EP maps made acoustic, each EP's area function and formants.
+
+Every EP of ``artic ep-map`` keeps its whole shape; this stage turns each shape into a vocal tract (the
+config's lip tube and port defaults) and its formants F1-F4, net by net (a net's EPs are one batch of
+frames).  The maps' reach in the F1-F2 plane is the model's vowel space.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from ..acoustics.tube import Tube
+from ..config import load_config
+from ..errors import ArticError
+from ..io.store import atomic_h5, open_artifact, stored_content_hash
+from . import acoustics as acoustics_stage
+from . import epmap as epmap_stage
+from . import mesh as mesh_stage
+from . import vocal_tract as vt_stage
+from .base import Stage, up_to_date
+
+STAGE = Stage(name="acousticmaps", module=__name__, sections=("speaker", "vocal_tract", "acoustics"),
+              reads=("mesh", "epmaps"), kind="acoustic-map", hint="rerun 'artic acoustic-map'")
+FORMANTS = 4
+
+# male Japanese vowel averages (F1, F2 Hz; ../shared/reference/acoustics.md, Jo Chul-Ho's thesis, Table 4.3)
+JAPANESE_VOWELS = {"a": (753.0, 1385.0), "i": (315.0, 2172.0), "u": (367.0, 1332.0), "e": (500.0, 1947.0),
+                   "o": (520.0, 997.0)}
+
+
+@dataclass
+class NetAcoustics:
+    formants_hz: np.ndarray  # (*grid, 4)
+    bandwidths_hz: np.ndarray  # (*grid, 4)
+    area_cm2: np.ndarray  # (*grid, sections)
+    length_cm: np.ndarray  # (*grid, sections)
+    min_area_cm2: np.ndarray  # (*grid,)
+
+
+@dataclass
+class AcousticMaps:
+    jaws: dict[str, dict[str, NetAcoustics]]  # jaw -> "rest" | "single/SG" | "pair/SG+HG" ... -> acoustics
+    attrs: dict = field(default_factory=dict)
+
+    def points(self, jaw: str) -> np.ndarray:
+        """(P, 4) every EP's formants at a jaw position (the rest first)."""
+        return np.concatenate([n.formants_hz.reshape(-1, FORMANTS) for n in self.jaws[jaw].values()])
+
+
+def _net(vt, cfg, mesh, maps, shapes: np.ndarray) -> NetAcoustics:
+    grid = shapes.shape[:-2]
+    flat = shapes.reshape(-1, *shapes.shape[-2:]).astype(float)
+    sh = vt_stage.shapes_of(flat, np.zeros(len(flat)), mesh, maps.model_rest, maps.mandible_nodes)
+    t = vt_stage.compute(vt, cfg.speaker.wall, sh, vt_stage.controls_for(vt, sh.time_s))
+    tubes = [Tube(t.af.length_cm[k], t.af.area_cm2[k]) for k in range(t.n_frames)]
+    ports = acoustics_stage.port_positions(t)
+    ac = acoustics_stage.compute(tubes, cfg, velum_area_cm2=t.controls["velum_port_cm2"], port_from_glottis_cm=ports)
+    return NetAcoustics(formants_hz=ac.formants_hz[:, :FORMANTS].reshape(*grid, FORMANTS),
+                        bandwidths_hz=ac.bandwidths_hz[:, :FORMANTS].reshape(*grid, FORMANTS),
+                        area_cm2=t.af.area_cm2.reshape(*grid, -1), length_cm=t.af.length_cm.reshape(*grid, -1),
+                        min_area_cm2=t.af.area_cm2.min(axis=1).reshape(grid))
+
+
+def compute(cfg, mesh, maps, progress: Callable[[int, int], None] | None = None) -> AcousticMaps:
+    vt = vt_stage.speaker_tract(cfg)
+    if maps.model_rest is None or any(jm.rest_shape is None for jm in maps.jaws.values()):
+        raise ArticError("the EP maps keep no shapes (an older artic built them); rerun 'artic ep-map'")
+    jobs = [(jname, "rest", jm.rest_shape[None]) for jname, jm in maps.jaws.items()]
+    for jname, jm in maps.jaws.items():
+        for fam in ("single", "pair", "group"):
+            for name, net in getattr(jm, fam).items():
+                jobs.append((jname, f"{fam}/{name}", net.shapes))
+    out: dict[str, dict[str, NetAcoustics]] = {j: {} for j in maps.jaws}
+    total = sum(int(np.prod(s.shape[:-2])) for _, _, s in jobs)
+    done = 0
+    for jname, key, shapes in jobs:
+        if progress is not None:
+            progress(done, total)
+        out[jname][key] = _net(vt, cfg, mesh, maps, shapes)
+        done += int(np.prod(shapes.shape[:-2]))
+    if progress is not None:
+        progress(total, total)
+    return AcousticMaps(jaws=out)
+
+
+def write(path: Path | str, result: AcousticMaps, prov=None) -> None:
+    with atomic_h5(path, STAGE.kind, prov) as f:
+        f.attrs["layout"] = ("jaw_positions/<jaw>/<rest | single/M | pair/A+B | group/I+A+B>/{formants_hz, "
+                             "bandwidths_hz (*grid x 4), area_cm2, length_cm (*grid x sections, glottis first), "
+                             "min_area_cm2}: the grids of the EP maps' nets")
+        f.attrs["jaw_order"] = list(result.jaws)
+        for jname, nets in result.jaws.items():
+            g = f.create_group(f"jaw_positions/{jname}")
+            g.attrs["order"] = list(nets)
+            for key, n in nets.items():
+                h = g.create_group(key)
+                for name, data, unit in (("formants_hz", n.formants_hz, "Hz"), ("bandwidths_hz", n.bandwidths_hz, "Hz"),
+                                         ("area_cm2", n.area_cm2, "cm^2"), ("length_cm", n.length_cm, "cm"),
+                                         ("min_area_cm2", n.min_area_cm2, "cm^2")):
+                    h.create_dataset(name, data=data, compression="gzip").attrs["units"] = unit
+
+
+def read(path: Path | str) -> AcousticMaps:
+    with open_artifact(path, STAGE.kind, STAGE.hint) as f:
+        try:
+            jaws = {}
+            for jname in f.attrs["jaw_order"]:
+                g = f["jaw_positions"][jname]
+                jaws[str(jname)] = {str(k): NetAcoustics(**{d: g[k][d][()] for d in (
+                    "formants_hz", "bandwidths_hz", "area_cm2", "length_cm", "min_area_cm2")}) for k in g.attrs["order"]}
+            return AcousticMaps(jaws=jaws, attrs={k: v for k, v in f.attrs.items()})
+        except (KeyError, ValueError, OSError, TypeError) as err:
+            raise ArticError(f"{path} is damaged or incomplete ({type(err).__name__}); {STAGE.hint}") from None
+
+
+@dataclass
+class AcousticMapResult:
+    path: Path
+    maps: AcousticMaps
+    up_to_date: bool = False
+
+
+def acoustic_map(maps: Path | str = "data/epmaps.h5", mesh: Path | str = "data/mesh.h5",
+                 config: Path | str | None = None, out: Path | str = "data/acoustic_maps.h5",
+                 progress: Callable[[int, int], None] | None = None, force: bool = False) -> AcousticMapResult:
+    """The formants of every EP of the maps (left alone when ``out`` holds this recipe)."""
+    cfg = load_config(config)
+    m = mesh_stage.read(mesh, cfg)
+    ep = epmap_stage.read(maps, mesh)
+    out = Path(out)
+    prov = STAGE.provenance(cfg, inputs={"mesh": m.content_sha256, "epmaps": str(stored_content_hash(maps))})
+    if not force and up_to_date(out, prov):
+        return AcousticMapResult(out, read(out), up_to_date=True)
+    result = compute(cfg, m.mesh, ep, progress)
+    write(out, result, prov)
+    return AcousticMapResult(out, result)
