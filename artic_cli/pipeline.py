@@ -33,6 +33,7 @@ class Pipeline(Strict):
     tissue_without_constraint: list[str] = []
     articulator_schedules: list[str] = []
     animated: list[str] = []
+    tract_schedules: list[str] = []  # articulator schedules whose simulations get a vocal tract and acoustics
     experiments: list[str] = []
     targets: list[str] = []
 
@@ -44,6 +45,10 @@ def load_pipeline(path: Path | str) -> Pipeline:
     for name in p.tissue_schedules + p.tissue_without_constraint + p.articulator_schedules + p.animated:
         if not (ROOT / "configs" / "schedules" / f"{name}.yaml").is_file():
             raise ArticError(f"{path}: schedule '{name}' has no configs/schedules/{name}.yaml")
+    for name in p.tract_schedules:
+        if name not in p.articulator_schedules:
+            raise ArticError(f"{path}: tract_schedules lists '{name}', which articulator_schedules does not simulate; "
+                             "add it there")
     for name in p.experiments:
         if name not in EXPERIMENTS:
             raise ArticError(f"{path}: unknown experiment '{name}'; valid: {', '.join(EXPERIMENTS)}")

@@ -26,7 +26,7 @@ def make(*args, timeout=1200):
 @pytest.fixture(scope="module")
 def built(tmp_path_factory):
     out = tmp_path_factory.mktemp("pipeline")
-    res = make("paper", "CONFIG=configs/ci_thin.yaml", f"OUT={out}")
+    res = make("-j2", "paper", "CONFIG=configs/ci_thin.yaml", f"OUT={out}")  # two stages at a time, as on 2 cores
     assert res.returncode == 0, res.stdout[-3000:] + res.stderr[-3000:]
     return out
 
@@ -119,14 +119,14 @@ def test_the_tracts_of_the_pipeline_and_of_one_ep(built, tmp_path):
 
     rest = vts.read(built / "tracts" / "rest.h5")
     assert 16.5 <= rest.af.tract_length_cm[0] <= 18.0
-    for name in ("fig4_ggp", "fig4_sg", "art_sg_jo"):
+    for name in ("art_sg_jo",):
         t = vts.read(built / "tracts" / f"{name}.h5")
         with h5py.File(built / "sims" / f"{name}.h5", "r") as f:
             assert t.n_frames == f["time"].shape[0]
     from artic_cli.stages.acoustics import read as read_acoustics
     from artic_cli.stages.synthesize import read_wav
 
-    for name in ("rest", "fig4_ggp", "fig4_sg", "art_sg_jo"):
+    for name in ("rest", "art_sg_jo"):
         ac = read_acoustics(built / "acoustics" / f"{name}.h5")
         assert ac.formants_hz.shape[1] == 5 and np.isfinite(ac.formants_hz[:, :3]).all()
     samples, rate = read_wav(built / "audio" / "rest.wav")
