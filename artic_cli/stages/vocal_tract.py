@@ -25,7 +25,7 @@ from ..io.fingerprint import digest, sections_hash
 from ..io.store import Provenance, atomic_h5, atomic_path, open_artifact
 from ..mechanics.contact import rigid_motion
 from ..mechanics.model import ARTICULATOR_SECTIONS
-from ..schedule import TRACT_CONTROLS, Schedule, TractEntry, parse_schedule, tract_controls
+from ..schedule import Schedule, TractEntry, parse_schedule, tract_controls
 from ..validation import check_number
 from . import mesh as mesh_stage
 from . import simulate as simulate_stage
