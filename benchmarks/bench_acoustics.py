@@ -3,7 +3,6 @@ VocalTractLab's transfer function side by side where it is installed.  Goals (is
 
 from __future__ import annotations
 
-import time
 
 import numpy as np
 
@@ -12,15 +11,8 @@ from artic_cli.acoustics.model import air_of, tract_of
 from artic_cli.acoustics.transfer import transfer
 from artic_cli.acoustics.tube import Tube
 from artic_cli.config import load_config
+from timing import median_time  # benchmarks/timing.py
 
-
-def _median(fn, n=7):
-    times = []
-    for _ in range(n):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return float(np.median(times))
 
 
 def main() -> None:
@@ -31,7 +23,7 @@ def main() -> None:
              for p in rng.uniform(0, 6, 200)]
     f = np.linspace(ac.max_frequency_hz / 1024, ac.max_frequency_hz, 1024)
     tract = tract_of(tubes[0], ac)
-    one = _median(lambda: transfer(tract, f, air))
+    one = median_time(lambda: transfer(tract, f, air))
     print(f"one transfer function, 1024 frequencies, 44 sections + piriform fossa: {one * 1e3:.2f} ms "
           f"(goal <= 5 ms: {'met' if one <= 0.005 else 'NOT met'})")
 
@@ -40,7 +32,7 @@ def main() -> None:
             tr = tract_of(t, ac)
             formants(lambda x, tr=tr: np.abs(transfer(tr, x, air)), ac.max_frequency_hz, ac.formant_search_step_hz)
 
-    tr_time = _median(tracks, n=3)
+    tr_time = median_time(tracks, n=3)
     print(f"formant tracks (F1-F5 with bandwidths), 200 frames: {tr_time:.2f} s "
           f"(goal <= 1 s: {'met' if tr_time <= 1.0 else 'NOT met'})")
     from artic_cli.stages.synthesize import compute_frames
@@ -50,7 +42,7 @@ def main() -> None:
     areas = np.stack([t.area_cm2 for t in tubes])
     times = np.linspace(0.0, 1.0, 200)
     compute_frames(lengths[:2], areas[:2], times[:2], cfg, 0.05)  # compile (or load) the line
-    syn = _median(lambda: compute_frames(lengths, areas, times, cfg, 1.0), n=3)
+    syn = median_time(lambda: compute_frames(lengths, areas, times, cfg, 1.0), n=3)
     print(f"1 s of audio (44.1 kHz) from 200 frames: {syn:.2f} s (goal <= 1 s: {'met' if syn <= 1.0 else 'NOT met'})")
     try:
         import vocaltractlab_cython as vtl
@@ -58,7 +50,7 @@ def main() -> None:
         print("VocalTractLab not installed (pip install vocaltractlab-cython): no side-by-side figure")
         return
     shape = vtl.get_shape("a", "tract")
-    theirs = _median(lambda: vtl.tract_state_to_transfer_function(shape, n_spectrum_samples=2048))
+    theirs = median_time(lambda: vtl.tract_state_to_transfer_function(shape, n_spectrum_samples=2048))
     print(f"VocalTractLab, one transfer function (its default, 2048-point spectrum): {theirs * 1e3:.2f} ms; "
           f"ours / theirs = {one / theirs:.2f}")
 

@@ -4,7 +4,6 @@ memory linear in frames."""
 
 from __future__ import annotations
 
-import time
 import tracemalloc
 
 import numpy as np
@@ -12,15 +11,8 @@ import numpy as np
 from artic_cli.config import load_config
 from artic_cli.geometry.mesh import tongue_mesh
 from artic_cli.stages.vocal_tract import Shapes, compute, controls_for
+from timing import median_time  # benchmarks/timing.py
 
-
-def _median(fn, n=7):
-    times = []
-    for _ in range(n):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return float(np.median(times))
 
 
 def _shapes(mesh, frames: int) -> Shapes:
@@ -47,8 +39,8 @@ def main() -> None:
     mesh = tongue_mesh(cfg.speaker.tongue)
     one, many = _shapes(mesh, 1), _shapes(mesh, 200)
     c1, c200 = controls_for(vt, one.time_s), controls_for(vt, many.time_s)
-    t1 = _median(lambda: compute(vt, wall, one, c1), n=21)
-    t200 = _median(lambda: compute(vt, wall, many, c200), n=5)
+    t1 = median_time(lambda: compute(vt, wall, one, c1), n=21)
+    t200 = median_time(lambda: compute(vt, wall, many, c200), n=5)
     print(f"one frame: {t1 * 1e3:.2f} ms (goal <= 2 ms: {'met' if t1 <= 0.002 else 'NOT met'})")
     print(f"200 frames (a 1-s simulation at 5 ms): {t200:.3f} s (goal <= 0.5 s: {'met' if t200 <= 0.5 else 'NOT met'}); "
           f"{t200 / 200 * 1e3:.2f} ms per frame")

@@ -397,15 +397,14 @@ def plot_acoustics_cmd(
     """The transfer function with the formants marked, or the formant tracks of a time series."""
     from ..plots.acoustics import plot_tracks, plot_transfer
     from ..stages.acoustics import read
+    from ..stages.vocal_tract import pick_frame
 
     r = read(result)
     n = len(r.formants_hz)
-    if frame is not None and not -n <= frame < n:
-        raise ArticError(f"--frame {frame} is out of range: the file has {n} frames (0 to {n - 1}); give one of them")
     if n > 1 and frame is None:
         path = plot_tracks(r, out, title=f"{result.stem}: formant tracks")
     else:
-        path = plot_transfer(r, 0 if frame is None else frame % n, out, title=result.stem)
+        path = plot_transfer(r, pick_frame(n, frame), out, title=result.stem)
     out_console.print(f"wrote {path}", highlight=False)
 
 

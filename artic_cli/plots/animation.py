@@ -6,10 +6,9 @@ from pathlib import Path
 
 import matplotlib.pyplot as plt
 import numpy as np
-from matplotlib.animation import FuncAnimation, PillowWriter
+from matplotlib.animation import FuncAnimation
 
-from ..io.store import atomic_path
-from .common import WALL_STYLE, draw_wall, wall_outlines
+from .common import WALL_STYLE, draw_wall, save_animation, wall_outlines
 
 
 def animate_simulation(traj, model, wall, path: Path | str, fps: int = 20, max_frames: int = 80) -> Path:
@@ -58,10 +57,4 @@ def animate_simulation(traj, model, wall, path: Path | str, fps: int = 20, max_f
         title.set_text(f"t = {traj.time[k] * 1e3:.0f} ms")
         return [*radial, *rings, jaw_line, *marks.values(), title]
 
-    anim = FuncAnimation(fig, draw, frames=frames, blit=False)
-    try:
-        with atomic_path(path, ".gif") as tmp:
-            anim.save(tmp, writer=PillowWriter(fps=fps))
-    finally:
-        plt.close(fig)
-    return path
+    return save_animation(fig, FuncAnimation(fig, draw, frames=frames, blit=False), path, fps)

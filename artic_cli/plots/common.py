@@ -27,6 +27,19 @@ def save_figure(fig, path: Path | str, dpi: int = 130) -> Path:
     return path
 
 
+def save_animation(fig, animation, path: Path | str, fps: int) -> Path:
+    """Write an animated GIF atomically and close the figure."""
+    from matplotlib.animation import PillowWriter
+
+    path = Path(path)
+    try:
+        with atomic_path(path, ".gif") as tmp:
+            animation.save(tmp, writer=PillowWriter(fps=fps))
+    finally:
+        plt.close(fig)
+    return path
+
+
 def wall_outlines(wall: WallSurface, z: float = 0.0):
     """Midsagittal (or other slice) outline of each wall part: {part: (n,2) array}."""
     out = {}

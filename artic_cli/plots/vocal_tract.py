@@ -6,10 +6,9 @@ from pathlib import Path
 
 import matplotlib.pyplot as plt
 import numpy as np
-from matplotlib.animation import FuncAnimation, PillowWriter
+from matplotlib.animation import FuncAnimation
 
-from ..io.store import atomic_path
-from .common import save_figure
+from .common import save_animation, save_figure
 
 STYLE = {"tongue": ("#c0392b", 2.0), "lower_incisor": ("#8a6d3b", 2.0), "lower_lip": ("#d98880", 2.0),
          "upper_lip": ("#d98880", 2.0), "upper_incisor": ("#8a6d3b", 2.0), "larynx_front": ("#2e86c1", 1.6),
@@ -100,10 +99,4 @@ def animate_tracts(t, path: Path | str, fps: int = 20, max_frames: int = 80) -> 
         title.set_text(f"t = {t.time_s[k] * 1e3:.0f} ms")
         return [*artists, *lines, mid, step, mark, title]
 
-    anim = FuncAnimation(fig, draw, frames=frames, blit=False)
-    try:
-        with atomic_path(path, ".gif") as tmp:
-            anim.save(tmp, writer=PillowWriter(fps=fps))
-    finally:
-        plt.close(fig)
-    return path
+    return save_animation(fig, FuncAnimation(fig, draw, frames=frames, blit=False), path, fps)

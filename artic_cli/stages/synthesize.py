@@ -152,18 +152,24 @@ def _check_out(out: Path | str) -> Path:
     return out
 
 
-def synthesize_tube(tube: Path | str, out: Path | str, duration_s: float, f0_hz: float | None = 110.0,
-                    f0_contour: Path | str | None = None, config: Path | str | None = None,
-                    amplitude_contour: Path | str | None = None, aspiration: float = 0.0) -> Audio:
+def _voice_inputs(out, duration_s, f0_hz, f0_contour, amplitude_contour, aspiration):
+    """The output path and the voice's options, checked; the contour files read: (out, f0 points, gains)."""
     check_number("--duration", duration_s, gt=0, le=MAX_DURATION_S, unit="s")
     if f0_contour is None:
         check_number("--f0", f0_hz, ge=50, le=500, unit="Hz")
     check_number("--aspiration", aspiration, ge=0, le=10)
     out = _check_out(out)
-    cfg = load_config(config)
-    t = read_tube_csv(tube)
     contour = read_f0_contour(f0_contour) if f0_contour is not None else None
     amp = read_amplitude_contour(amplitude_contour) if amplitude_contour is not None else None
+    return out, contour, amp
+
+
+def synthesize_tube(tube: Path | str, out: Path | str, duration_s: float, f0_hz: float | None = 110.0,
+                    f0_contour: Path | str | None = None, config: Path | str | None = None,
+                    amplitude_contour: Path | str | None = None, aspiration: float = 0.0) -> Audio:
+    out, contour, amp = _voice_inputs(out, duration_s, f0_hz, f0_contour, amplitude_contour, aspiration)
+    cfg = load_config(config)
+    t = read_tube_csv(tube)
     audio = compute(t, cfg, duration_s, f0_hz, contour, amp, aspiration)
     write(out, audio)
     return audio
@@ -176,18 +182,12 @@ def synthesize_tracts(tracts: Path | str, out: Path | str, f0_hz: float | None =
     """The sound of a vocal-tract file's frames (one frame: held for ``duration_s``, default 1 s)."""
     from . import vocal_tract as vt_stage
 
-    check_number("--duration", duration_s, gt=0, le=MAX_DURATION_S, unit="s")
-    if f0_contour is None:
-        check_number("--f0", f0_hz, ge=50, le=500, unit="Hz")
-    check_number("--aspiration", aspiration, ge=0, le=10)
-    out = _check_out(out)
+    out, contour, amp = _voice_inputs(out, duration_s, f0_hz, f0_contour, amplitude_contour, aspiration)
     cfg = load_config(config)
     t = vt_stage.read(tracts)
     span = float(t.time_s[-1] - t.time_s[0])
     if duration_s is None:
         duration_s = span if t.n_frames > 1 and span > 0 else 1.0
-    contour = read_f0_contour(f0_contour) if f0_contour is not None else None
-    amp = read_amplitude_contour(amplitude_contour) if amplitude_contour is not None else None
     audio = compute_frames(t.af.length_cm, t.af.area_cm2, t.time_s, cfg, duration_s, f0_hz, contour, amp, aspiration)
     write(out, audio)
     return audio

@@ -153,18 +153,20 @@ def compute(vt: VocalTract, cfg_wall, shapes: Shapes, controls: dict[str, np.nda
                          f"{grid.reach_cm:g} cm; the shape left the grid (raise vocal_tract.grid.reach_cm)")
     band, z = None, None
     if len(geo.outer) > 1:
-        band, z = band_area(vt, geo, shapes, af)
+        band, z = band_area(vt, geo, shapes, af, inner)
     return Tracts(time_s=shapes.time_s, af=af, controls=controls, grid=grid, contours=moving, fixed=dict(geo.drawn),
                   band_area_cm2=band, band_z_cm=z)
 
 
-def band_area(vt: VocalTract, geo: Fixed, shapes: Shapes, af: AreaFunctions) -> tuple[np.ndarray, np.ndarray]:
+def band_area(vt: VocalTract, geo: Fixed, shapes: Shapes, af: AreaFunctions, inner_mid: np.ndarray
+              ) -> tuple[np.ndarray, np.ndarray]:
     """The cross-section of the band the tongue mesh spans (|z| <= its lateral planes) from the 3-D geometry:
-    distances in the midsagittal plane, half-way and in the lateral plane, integrated across."""
+    distances in the midsagittal plane (``inner_mid``: its inner segments, already built), half-way and in the
+    lateral plane, integrated across."""
     z = np.array(list(geo.outer))
-    planes = [shapes.tongue_cm, 0.5 * (shapes.tongue_cm + shapes.tongue_lateral_cm), shapes.tongue_lateral_cm]
-    inners = [segments(inner_polylines(vt, moving_parts(vt, tongue, shapes.jaw_rotation, shapes.jaw_translation)))
-              for tongue in planes]
+    side = [0.5 * (shapes.tongue_cm + shapes.tongue_lateral_cm), shapes.tongue_lateral_cm]
+    inners = [inner_mid] + [segments(inner_polylines(vt, moving_parts(vt, tongue, shapes.jaw_rotation,
+                                                                      shapes.jaw_translation))) for tongue in side]
     return band_areas(geo.grid, inners, list(geo.outer.values()), z, af.inner_s_cm, af.wall_s_cm), z
 
 
@@ -260,7 +262,7 @@ def pick_frame(t: Tracts | int, frame: int | None) -> int:
     n = t if isinstance(t, int) else t.n_frames
     k = n - 1 if frame is None else int(frame)
     if not -n <= k < n:
-        raise ArticError(f"--frame {frame} is out of range: the tracts have {n} frames (0 to {n - 1}); give one of them")
+        raise ArticError(f"--frame {frame} is out of range: the file has {n} frames (0 to {n - 1}); give one of them")
     return k % n
 
 
