@@ -99,6 +99,8 @@ class Simulation(Strict):
     newton_max_iter: Annotated[int, Field(ge=1, le=200)] = 25
     refactor_rate: Annotated[float, Field(gt=0, lt=1)] = 0.25
     record_every: Annotated[int, Field(ge=1)] = 1
+    # left-right symmetry: the articulator's midsagittal tongue nodes keep z = 0 (no antisymmetric buckling)
+    midsagittal_symmetry: bool = False
 
 
 class Muscles(Strict):
@@ -110,6 +112,8 @@ class Muscles(Strict):
     passive_k1_ratio: NonNeg = 0.05
     maxwell_k2_ratio: Positive = 2.0
     maxwell_b2_ratio: Positive = 0.1
+    # Eq. (9) evaluated at fibre strain / width: 1 is the paper's curve (active force zero below -18.5 %)
+    force_length_width: Annotated[float, Field(ge=1.0, le=5.0)] = 1.0
     groups: dict[str, dict[str, Positive]] = {
         "JO": {"lateral_pterygoid_upper": 0.25, "lateral_pterygoid_lower": 0.25, "anterior_digastric": 0.5},
         "JC": {"temporalis_anterior": 0.3, "temporalis_posterior": 0.2, "masseter": 0.3, "medial_pterygoid": 0.2},

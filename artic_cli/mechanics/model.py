@@ -357,6 +357,8 @@ def build_articulator(cfg: Config, mesh: Mesh, wall: WallSurface | None = None, 
     kappa = np.full(len(mesh.bricks), bulk_ratio * scale * e0 if on else 0.0)
     fixed = np.zeros((n, 3), dtype=bool)
     fixed[body.fixed] = True
+    if cfg.simulation.midsagittal_symmetry:  # the midsagittal nodes stay in their plane (the carried ones follow the jaw)
+        fixed[np.setdiff1d(mesh.node_sets["midsagittal"], body.carried), 2] = True
 
     mc = cfg.muscles
     names = list(TONGUE_MUSCLES + JAW_MUSCLES)
@@ -368,7 +370,8 @@ def build_articulator(cfg: Config, mesh: Mesh, wall: WallSurface | None = None, 
         check_muscle_names(members, names, f"muscles.groups.{g}")
     ms = muscle_set(names, body.fibres, body.fibre_weight, mc.thickness_cm2, body.nodes,
                     k1=mc.passive_k1_ratio * e0, k2=mc.maxwell_k2_ratio * e0,
-                    b2=mc.maxwell_b2_ratio * units.kpa_to_cgs(tissue.viscosity_kpa_s))
+                    b2=mc.maxwell_b2_ratio * units.kpa_to_cgs(tissue.viscosity_kpa_s),
+                    fl_width=mc.force_length_width)
 
     cond = np.array([body.names["condyle_l"], body.names["condyle_r"]])
     a = np.deg2rad(cfg.jaw.eminence_slope_deg)

@@ -5,11 +5,12 @@ origin to its insertion and carries one tension along every segment (a
 via-point muscle: a curved fibre also pushes on the nodes it bends around).
 The tension of fibre f with strain e = L/L0 - 1 is
 
-    T_f = s_f u fL(e) / fL(0)                      active (Eq. 9), u in dyn
+    T_f = s_f u fL(e / w) / fL(0)                  active (Eq. 9), u in dyn
         + A_f (k1(e) e + sigma2_f)                 passive parallel spring and Maxwell branch
 
 with fL the fourth-order force-length polynomial of Eq. (9), zero outside
--0.185 < e < 0.49; k1 = 0.05 k0 e for e > 0 (stretch only); the Maxwell
+-0.185 < e / w < 0.49, and w the config's ``muscles.force_length_width`` (1: the
+paper's curve); k1 = 0.05 k0 e for e > 0 (stretch only); the Maxwell
 branch sigma2' / k2 + sigma2 / b2 = e' with k2 = 2 k0, b2 = b / 10, advanced
 with the implicit step.  ``u`` is the muscle force in newtons at rest length
 (the paper's activation input); s_f the fibre's share of it; A_f the fibre's
@@ -37,16 +38,20 @@ def _polyval(coeffs, e: np.ndarray) -> np.ndarray:
     return out
 
 
-def force_length(strain: np.ndarray) -> np.ndarray:
-    """Eq. (9) normalised to 1 at rest length; zero outside its validity range."""
+def force_length(strain: np.ndarray, width: float = 1.0) -> np.ndarray:
+    """Eq. (9) normalised to 1 at rest length; zero outside its validity range.
+
+    ``width`` stretches the curve along the strain axis: fL(e / width) (1 is Eq. 9 as printed).
+    """
+    strain = strain / width
     f = _polyval(FL_COEFFS, strain) / FL_COEFFS[-1]
     return np.where((strain > FL_RANGE[0]) & (strain < FL_RANGE[1]), np.maximum(f, 0.0), 0.0)
 
 
-def force_length_slope(strain: np.ndarray) -> np.ndarray:
+def force_length_slope(strain: np.ndarray, width: float = 1.0) -> np.ndarray:
     """d fL / d strain of :func:`force_length` (zero where fL is zero)."""
-    slope = _polyval(FL_SLOPE_COEFFS, strain) / FL_COEFFS[-1]
-    return np.where(force_length(strain) > 0, slope, 0.0)
+    slope = _polyval(FL_SLOPE_COEFFS, strain / width) / (FL_COEFFS[-1] * width)
+    return np.where(force_length(strain, width) > 0, slope, 0.0)
 
 
 @dataclass(frozen=True)
@@ -63,6 +68,7 @@ class MuscleSet:
     k1: float  # passive stiffness coefficient, dyn/cm^2 (k1 = k1 * e)
     k2: float  # Maxwell spring, dyn/cm^2
     b2: float  # Maxwell dashpot, dyn s/cm^2
+    fl_width: float  # force-length width: Eq. (9) evaluated at strain / fl_width (1: as printed)
     diff: sp.csr_matrix  # (S, N) segment vectors
     seg_sum: sp.csr_matrix  # (F, S) sums segment lengths per fibre
     scatter: sp.csr_matrix  # (N, S) node force from segment force vectors
@@ -76,7 +82,8 @@ class MuscleSet:
 
 
 def muscle_set(names, fibres: dict[str, list[np.ndarray]], shares: dict[str, np.ndarray],
-               thickness: dict[str, float], nodes: np.ndarray, k1: float, k2: float, b2: float) -> MuscleSet:
+               thickness: dict[str, float], nodes: np.ndarray, k1: float, k2: float, b2: float,
+               fl_width: float = 1.0) -> MuscleSet:
     seg_i, seg_j, seg_f, f_m, f_share, f_area, f_l0 = [], [], [], [], [], [], []
     for m, name in enumerate(names):
         for fibre, share in zip(fibres[name], shares[name]):
@@ -98,7 +105,7 @@ def muscle_set(names, fibres: dict[str, list[np.ndarray]], shares: dict[str, np.
     return MuscleSet(names=tuple(names), seg_i=seg_i, seg_j=seg_j, seg_fibre=seg_f, fibre_muscle=np.array(f_m),
                      fibre_share=np.array(f_share), fibre_area=np.array(f_area), fibre_l0=np.array(f_l0),
                      seg_l0=np.linalg.norm(nodes[seg_j] - nodes[seg_i], axis=1),
-                     k1=k1, k2=k2, b2=b2, diff=diff, seg_sum=seg_sum, scatter=scatter)
+                     k1=k1, k2=k2, b2=b2, fl_width=fl_width, diff=diff, seg_sum=seg_sum, scatter=scatter)
 
 
 @dataclass
@@ -124,7 +131,7 @@ def fibre_state(ms: MuscleSet, x: np.ndarray, activation: np.ndarray, sigma2_pre
     strain = total / ms.fibre_l0 - 1.0
     sigma2 = (sigma2_prev + ms.k2 * (strain - strain_prev)) / (1.0 + h * ms.k2 / ms.b2) if h > 0 else sigma2_prev
     passive = ms.k1 * np.maximum(strain, 0.0) * strain + sigma2
-    active = activation[ms.fibre_muscle] * ms.fibre_share * force_length(strain)
+    active = activation[ms.fibre_muscle] * ms.fibre_share * force_length(strain, ms.fl_width)
     return FibreState(n=n, seg_length=length, strain=strain, tension=active + ms.fibre_area * passive, sigma2=sigma2)
 
 
@@ -135,7 +142,7 @@ def fibre_stiffness(ms: MuscleSet, fs: FibreState, activation: np.ndarray, h: fl
     """
     e = fs.strain
     maxwell = ms.k2 / (1.0 + h * ms.k2 / ms.b2) if h > 0 else 0.0
-    slope = (activation[ms.fibre_muscle] * ms.fibre_share * force_length_slope(e)
+    slope = (activation[ms.fibre_muscle] * ms.fibre_share * force_length_slope(e, ms.fl_width)
              + ms.fibre_area * (2.0 * ms.k1 * np.maximum(e, 0.0) + maxwell))
     return np.maximum(slope, 0.0) / ms.fibre_l0
 
@@ -177,5 +184,5 @@ def muscle_tensions(ms: MuscleSet, x: np.ndarray, activation: np.ndarray, sigma2
     """(M,) total force of each muscle (sum over its fibres), dyn, with the Maxwell state given."""
     strain = fibre_lengths(ms, x) / ms.fibre_l0 - 1.0
     passive = ms.k1 * np.maximum(strain, 0.0) * strain + sigma2
-    t = activation[ms.fibre_muscle] * ms.fibre_share * force_length(strain) + ms.fibre_area * passive
+    t = activation[ms.fibre_muscle] * ms.fibre_share * force_length(strain, ms.fl_width) + ms.fibre_area * passive
     return np.bincount(ms.fibre_muscle, weights=t, minlength=len(ms.names))

@@ -8,7 +8,7 @@ from artic_cli.experiments.paper import PAPER_DIRECTIONS, fig4, jaw_ep, muscle_d
 from artic_cli.mechanics.contact import wall_query
 from artic_cli.mechanics.loads import muscle_force_vector
 from artic_cli.mechanics.model import Control, build_articulator
-from artic_cli.mechanics.muscles import FL_RANGE, force_length
+from artic_cli.mechanics.muscles import FL_RANGE, force_length, force_length_slope
 from artic_cli.mechanics.simulate import run, settle
 from artic_cli.schedule import parse_schedule
 
@@ -25,6 +25,30 @@ def test_force_length_is_eq9_normalised_and_zero_outside_its_range():
     inside = np.linspace(FL_RANGE[0] + 0.02, 0.45, 50)  # the polynomial reaches zero near 0.47
     assert (force_length(inside) > 0).all()
     assert force_length(np.array([0.06]))[0] > 1.0  # the optimum lies just beyond rest length
+
+
+def test_a_wider_force_length_curve_is_eq9_stretched_along_the_strain():
+    e = np.linspace(-0.5, 0.8, 261)
+    assert np.array_equal(force_length(e, 1.5), force_length(e / 1.5))
+    assert force_length(np.array([-0.2]), 1.5)[0] > 0.35 and force_length(np.array([-0.2]))[0] == 0
+    inside = e[(e > 1.5 * FL_RANGE[0] + 0.01) & (e < 1.5 * 0.46)]
+    numeric = (force_length(inside + 1e-6, 1.5) - force_length(inside - 1e-6, 1.5)) / 2e-6
+    assert np.allclose(force_length_slope(inside, 1.5), numeric, rtol=1e-5, atol=1e-6)
+
+
+def test_midsagittal_symmetry_keeps_the_midline_in_its_plane(cfg, mesh, wall):
+    from artic_cli.mechanics.loads import control_from_newtons
+
+    model = build_articulator(cfg.model_copy(update={"simulation": cfg.simulation.model_copy(
+        update={"midsagittal_symmetry": True})}), mesh, wall)
+    mid = np.setdiff1d(mesh.node_sets["midsagittal"], model.node_sets["anchor"])
+    ctl = control_from_newtons(model, {"SL": 4.0}, loads_n={"tip": (0.0, 0.0, 0.2)})  # a sideways push
+    _, end = run(model, settle(model), lambda t: ctl, 0.05)
+    assert np.abs(end.x[mid, 2]).max() < 1e-12
+    free = build_articulator(cfg.model_copy(update={"simulation": cfg.simulation.model_copy(
+        update={"midsagittal_symmetry": False})}), mesh, wall)
+    _, end = run(free, settle(free), lambda t: ctl, 0.05)
+    assert np.abs(end.x[mid, 2]).max() > 1e-3  # without it the same push moves the midline sideways
 
 
 def test_body_has_the_paper_structure(art):

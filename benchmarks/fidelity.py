@@ -1,0 +1,146 @@
+"""Fidelity scorecard: the muscles' behaviour against Dang & Honda (2004) for any config, in about 15 s.
+
+    python benchmarks/fidelity.py [CONFIG] [--parts k,dir,t3,fig4,jaw,fm]
+
+k: SG alone at 0.5-4 N, jaw at rest: first dorsum-region contact and the dorsum's gap to the wall (cm);
+dir: the 16 definite directions of section IV.A.1 at 4 N (deg from the paper's; X: over 45 deg or a move
+under 0.05 cm); t3: Table III from the 6-N equilibria at the rest jaw, normalised by the largest single
+vector as the report does (GH included); fig4: Table II peak speeds (SG 4 N + JO 3 N, 20 ms); jaw: the
+eight jaw EPs (cm); fm: F1-F3 (Hz) of the rest tract and of a few held muscle sets.  Not part of make
+bench (it measures behaviour, not speed).
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+from artic_cli.config import load_config
+from artic_cli.experiments import paper as P
+from artic_cli.geometry.mesh import tongue_mesh
+from artic_cli.geometry.wall import wall_surface
+from artic_cli.mechanics.contact import wall_query
+from artic_cli.mechanics.model import build_articulator
+from artic_cli.mechanics.simulate import settle
+
+CPS = ("tip", "dorsum")
+
+
+def _gap(model, x, node) -> float:
+    return float(-wall_query(model.contact, x, np.array([node]))[2][0])
+
+
+def k_closure(model, rest, audit, pts) -> None:
+    region = set(model.node_sets["dorsum_region"].tolist())
+    for f in (0.5, 1.0, 1.5, 2.0, 3.0, 4.0):
+        traj, end = audit.run(rest, {"SG": f}, 0.3)
+        hit = any(region & set(c.tolist()) for c in traj.contact_nodes)
+        print(f"  SG {f:g} N: dorsum-region contact {'yes' if hit else 'no'}, dorsum gap {_gap(model, end.x, pts['dorsum']):.3f} cm")
+        if hit:
+            break
+
+
+def directions(rest, audit, pts) -> None:
+    off = 0
+    for m in ("GGa", "GGm", "GGp", "HG", "SG", "SL", "IL", "T", "V", "MH", "GH", "T-SL"):
+        _, end = audit.run(rest, {m: 4.0}, 0.3)
+        cells = []
+        for cp in CPS:
+            d = end.x[pts[cp], :2] - rest.x[pts[cp], :2]
+            ref = P.PAPER_DIRECTIONS.get(m, {}).get(cp)
+            if ref is None:
+                cells.append(f"{cp} {np.linalg.norm(d):.2f} cm (no definite direction)")
+                continue
+            err = np.degrees(np.arccos(np.clip(np.dot(d, ref) / max(np.linalg.norm(d), 1e-12), -1, 1)))
+            bad = err > 45 or np.linalg.norm(d) < 0.05
+            off += bad
+            cells.append(f"{cp} {np.linalg.norm(d):.2f} cm {err:3.0f} deg{' X' if bad else ''}")
+        print(f"  {m:5s} " + " | ".join(cells))
+    print(f"  directions off: {off} of 16")
+
+
+def table_iii(rest, audit, pts) -> None:
+    amp = {}
+    for m in (*P.PAPER_CONTRIBUTION, "GH"):
+        _, end = audit.run(rest, {m: 6.0}, 0.3)
+        amp[m] = [float(np.linalg.norm(end.x[pts[cp]] - rest.x[pts[cp]])) for cp in CPS]
+    top = [max(a[c] for a in amp.values()) for c in (0, 1)]
+    good = 0
+    for m, (pt, pd) in P.PAPER_CONTRIBUTION.items():
+        ft, fd = amp[m][0] / top[0], amp[m][1] / top[1]
+        ok = max(abs(ft - pt), abs(fd - pd)) <= 0.2
+        good += ok
+        print(f"  {m:5s} ours {ft:.2f} / {fd:.2f}  paper {pt:.2f} / {pd:.2f}  {'ok' if ok else 'X'}")
+    print(f"  Table III rows within 0.2: {good} of {len(P.PAPER_CONTRIBUTION)}")
+
+
+def fig4(rest, audit, pts) -> None:
+    traj, _ = audit.run(rest, {"SG": 4.0, "JO": 3.0}, 0.02)
+    for n, i in pts.items():
+        v = float(np.linalg.norm(traj.v[:, i, :2], axis=1).max())
+        print(f"  Table II {n}: {v:.1f} cm/s (paper {P.PAPER_FIG4_SG[n]:g}, {v / P.PAPER_FIG4_SG[n] - 1:+.0%})")
+
+
+def jaw_eps(rest, audit, pts) -> None:
+    for group, pairs in P.PAPER_JAW_EP.items():
+        for force, paper in pairs:
+            _, end = audit.run(rest, {group: force}, 0.3)
+            dy = float(end.x[pts["jaw"], 1] - rest.x[pts["jaw"], 1])
+            print(f"  jaw {group} {force:g} N: {dy:+.2f} cm (paper {paper:+.2f}, {dy / paper - 1:+.0%})")
+
+
+def formants(cfg, model, rest, audit) -> None:
+    from artic_cli.acoustics.tube import Tube
+    from artic_cli.stages import acoustics as ac_stage
+    from artic_cli.stages import vocal_tract as vt_stage
+
+    mesh = tongue_mesh(cfg.speaker.tongue)
+    vt = vt_stage.speaker_tract(cfg)
+    mandible = np.asarray(model.node_sets["mandible"])
+
+    def of(x):
+        shapes = vt_stage.shapes_of(x[None], np.zeros(1), mesh, model.rest, mandible)
+        tr = vt_stage.compute(vt, cfg.speaker.wall, shapes, vt_stage.controls_for(vt, np.zeros(1)))
+        res = ac_stage.compute([Tube(tr.af.length_cm[0], tr.af.area_cm2[0])], cfg,
+                               port_from_glottis_cm=ac_stage.port_positions(tr))
+        return res.formants_hz[0][:3], float(tr.af.area_cm2[0].min())
+
+    f, amin = of(rest.x)
+    print(f"  rest: F1-F3 {np.round(f).astype(int)} Hz (male /e/ 500 / 1947), smallest area {amin:.2f} cm^2")
+    for forces in ({"SG": 4.0}, {"GGp": 4.0}, {"HG": 4.0}, {"JO": 4.0, "HG": 2.0}, {"GGp": 4.0, "SL": 1.0}):
+        _, end = audit.run(rest, forces, 0.3)
+        f, amin = of(end.x)
+        name = " + ".join(f"{m} {v:g} N" for m, v in forces.items())
+        print(f"  {name}: F1-F3 {np.round(f).astype(int)} Hz, smallest area {amin:.2f} cm^2")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("config", nargs="?", default=None)
+    ap.add_argument("--parts", default="k,dir,t3,fig4,jaw,fm")
+    args = ap.parse_args()
+    parts = args.parts.split(",")
+    t0 = time.perf_counter()
+    cfg = load_config(args.config)
+    model = build_articulator(cfg, tongue_mesh(cfg.speaker.tongue), wall_surface(cfg.speaker.wall))
+    rest = settle(model)
+    pts = model.control_points()
+    audit = P.Audit(model)
+    print(f"rest: dorsum {_gap(model, rest.x, pts['dorsum']):.3f} cm from the wall")
+    for key, title, fn in (("k", "k-closure", lambda: k_closure(model, rest, audit, pts)),
+                           ("dir", "directions (4 N)", lambda: directions(rest, audit, pts)),
+                           ("t3", "Table III (6 N, rest jaw)", lambda: table_iii(rest, audit, pts)),
+                           ("fig4", "Table II", lambda: fig4(rest, audit, pts)),
+                           ("jaw", "jaw EPs", lambda: jaw_eps(rest, audit, pts)),
+                           ("fm", "formants", lambda: formants(cfg, model, rest, audit))):
+        if key in parts:
+            print(title)
+            fn()
+    print("audit: " + "; ".join(f"{r.name} {r.ours:.3g}" for r in audit.rows()) +
+          f" [{time.perf_counter() - t0:.0f} s]")
+
+
+if __name__ == "__main__":
+    main()
