@@ -161,6 +161,9 @@ class EPMapSpec(Strict):
     convergence_window_ms: Positive = 50.0
     convergence_tol_cm: Positive = 0.01  # converged: control points moved less than this over the last window
     early_stop_tol_cm: Positive = 0.002  # --fast: stop once they move less than this over a window
+    # the mandible held where the jaw position's rest has it while tongue muscles act (the paper: jaw forces
+    # held, the jaw free); also the muscle directions and k-closure experiments
+    hold_jaw: bool = False
     jaw_positions: dict[str, dict[str, NonNeg]] = JAW_POSITIONS  # name -> jaw forces held (N)
     typical_jaw: str = "JO_0.5"
     levels_n: list[NonNeg] = [0.0, 0.1, 0.2, 0.4, 1.0, 2.5, 4.0, 6.0]

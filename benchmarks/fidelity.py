@@ -5,7 +5,7 @@
 k: SG alone at 0.5-4 N, jaw at rest: first dorsum-region contact and the dorsum's gap to the wall (cm);
 dir: the 16 definite directions of section IV.A.1 at 4 N (deg from the paper's; X: over 45 deg or a move
 under 0.05 cm); t3: Table III from the 6-N equilibria at the rest jaw, normalised by the largest single
-vector as the report does (GH included); fig4: Table II peak speeds (SG 4 N + JO 3 N, 20 ms); jaw: the
+vector as the report does (GH included); k, dir and t3 hold the jaw when the config's epmap.hold_jaw says so; fig4: Table II peak speeds (SG 4 N + JO 3 N, 20 ms); jaw: the
 eight jaw EPs (cm); fm: F1-F3 (Hz) of the rest tract and of a few held muscle sets.  Not part of make
 bench (it measures behaviour, not speed).
 """
@@ -32,20 +32,20 @@ def _gap(model, x, node) -> float:
     return float(-wall_query(model.contact, x, np.array([node]))[2][0])
 
 
-def k_closure(model, rest, audit, pts) -> None:
+def k_closure(model, rest, audit, pts, hold) -> None:
     region = set(model.node_sets["dorsum_region"].tolist())
     for f in (0.5, 1.0, 1.5, 2.0, 3.0, 4.0):
-        traj, end = audit.run(rest, {"SG": f}, 0.3)
+        traj, end = audit.run(rest, {"SG": f}, 0.3, hold)
         hit = any(region & set(c.tolist()) for c in traj.contact_nodes)
         print(f"  SG {f:g} N: dorsum-region contact {'yes' if hit else 'no'}, dorsum gap {_gap(model, end.x, pts['dorsum']):.3f} cm")
         if hit:
             break
 
 
-def directions(rest, audit, pts) -> None:
+def directions(rest, audit, pts, hold) -> None:
     off = 0
     for m in ("GGa", "GGm", "GGp", "HG", "SG", "SL", "IL", "T", "V", "MH", "GH", "T-SL"):
-        _, end = audit.run(rest, {m: 4.0}, 0.3)
+        _, end = audit.run(rest, {m: 4.0}, 0.3, hold)
         cells = []
         for cp in CPS:
             d = end.x[pts[cp], :2] - rest.x[pts[cp], :2]
@@ -61,10 +61,10 @@ def directions(rest, audit, pts) -> None:
     print(f"  directions off: {off} of 16")
 
 
-def table_iii(rest, audit, pts) -> None:
+def table_iii(rest, audit, pts, hold) -> None:
     amp = {}
     for m in (*P.PAPER_CONTRIBUTION, "GH"):
-        _, end = audit.run(rest, {m: 6.0}, 0.3)
+        _, end = audit.run(rest, {m: 6.0}, 0.3, hold)
         amp[m] = [float(np.linalg.norm(end.x[pts[cp]] - rest.x[pts[cp]])) for cp in CPS]
     top = [max(a[c] for a in amp.values()) for c in (0, 1)]
     good = 0
@@ -128,10 +128,12 @@ def main() -> None:
     rest = settle(model)
     pts = model.control_points()
     audit = P.Audit(model)
-    print(f"rest: dorsum {_gap(model, rest.x, pts['dorsum']):.3f} cm from the wall")
-    for key, title, fn in (("k", "k-closure", lambda: k_closure(model, rest, audit, pts)),
-                           ("dir", "directions (4 N)", lambda: directions(rest, audit, pts)),
-                           ("t3", "Table III (6 N, rest jaw)", lambda: table_iii(rest, audit, pts)),
+    hold = cfg.epmap.hold_jaw
+    print(f"rest: dorsum {_gap(model, rest.x, pts['dorsum']):.3f} cm from the wall"
+          f"{'; tongue muscles with the jaw held (epmap.hold_jaw)' if hold else ''}")
+    for key, title, fn in (("k", "k-closure", lambda: k_closure(model, rest, audit, pts, hold)),
+                           ("dir", "directions (4 N)", lambda: directions(rest, audit, pts, hold)),
+                           ("t3", "Table III (6 N, rest jaw)", lambda: table_iii(rest, audit, pts, hold)),
                            ("fig4", "Table II", lambda: fig4(rest, audit, pts)),
                            ("jaw", "jaw EPs", lambda: jaw_eps(rest, audit, pts)),
                            ("fm", "formants", lambda: formants(cfg, model, rest, audit))):

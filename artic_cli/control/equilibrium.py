@@ -16,6 +16,7 @@ from .. import units
 from ..config import ConfigView, EPMapSpec, parse_config
 from ..geometry.mesh import Mesh
 from ..geometry.wall import WallSurface
+from ..mechanics.jaw_hold import fresh_start, hold_jaw
 from ..mechanics.loads import muscle_force_vector
 from ..mechanics.model import ARTICULATOR_SECTIONS, Control, Model, State, build_articulator
 from ..mechanics.simulate import equilibrate, hold, settle
@@ -66,6 +67,8 @@ def equilibrium_state(model: Model, start: State, forces_n: dict[str, float], sp
                       fast: bool = False) -> tuple[State, EP]:
     """Hold the forces for ``spec.duration_ms`` (``fast``: stop once settled): the whole final state and the
     EP read from it."""
+    if spec.hold_jaw:  # the jaw position's mandible stays where the start has it
+        model, start = hold_jaw(model, start.x), fresh_start(start)
     h = hold(model, start, control_for(model, forces_n), units.ms_to_s(spec.duration_ms), watch_nodes(model),
              units.ms_to_s(spec.convergence_window_ms), stop_below=spec.early_stop_tol_cm if fast else None)
     return h.state, EP(x=h.state.x[watch_nodes(model)].copy(), drift_cm=h.drift,
@@ -123,4 +126,6 @@ def spec_key(spec: EPMapSpec) -> str:
     """The parts of the spec an EP depends on (not the lists of what to compute)."""
     keep = {k: getattr(spec, k) for k in ("duration_ms", "convergence_window_ms", "convergence_tol_cm",
                                           "early_stop_tol_cm")}
+    if spec.hold_jaw:
+        keep["hold_jaw"] = True
     return json.dumps(keep, sort_keys=True)

@@ -12,6 +12,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from ..mechanics.contact import wall_query
+from ..mechanics.jaw_hold import fresh_start, hold_jaw
 from ..mechanics.loads import control_from_newtons
 from ..mechanics.model import Model
 from ..mechanics.simulate import run, settle
@@ -64,9 +65,13 @@ class Audit:
         self.inverted = 0
         self.runs = 0
 
-    def run(self, rest, forces_n: dict[str, float], duration: float):
-        ctl = control_from_newtons(self.model, forces_n)
-        traj, end = run(self.model, rest, lambda t: ctl, duration)
+    def run(self, rest, forces_n: dict[str, float], duration: float, hold: bool = False):
+        """Hold the forces from ``rest`` (``hold``: with the mandible held where ``rest`` has it)."""
+        model = self.model
+        if hold:
+            model, rest = hold_jaw(model, rest.x), fresh_start(rest)
+        ctl = control_from_newtons(model, forces_n)
+        traj, end = run(model, rest, lambda t: ctl, duration)
         self.runs += 1
         self.volume = max(self.volume, float(np.abs(traj.volume_change).max()))
         self.inverted = max(self.inverted, int(traj.inverted.max()))
@@ -112,13 +117,14 @@ def fig4(model: Model) -> list[Row]:
     return rows + audit.rows()
 
 
-def muscle_directions(model: Model, force: float = 4.0, duration: float = 0.3) -> list[Row]:
+def muscle_directions(model: Model, force: float = 4.0, duration: float = 0.3, hold: bool = False) -> list[Row]:
+    """Section IV.A.1's directions: each tongue muscle alone from rest (``hold``: the jaw held at rest)."""
     rest = settle(model)
     pts = model.control_points()
     audit = Audit(model)
     rows = []
     for muscle in ("GGa", "GGm", "GGp", "HG", "SG", "SL", "IL", "T", "V", "GH", "MH", "T-SL"):
-        _, end = audit.run(rest, {muscle: force}, duration)
+        _, end = audit.run(rest, {muscle: force}, duration, hold)
         for cp in ("tip", "dorsum"):
             d = end.x[pts[cp], :2] - rest.x[pts[cp], :2]
             paper = PAPER_DIRECTIONS.get(muscle, {}).get(cp)
@@ -133,15 +139,16 @@ def muscle_directions(model: Model, force: float = 4.0, duration: float = 0.3) -
     return rows + audit.rows()
 
 
-def k_closure(model: Model, forces=(0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0, 4.0), duration: float = 0.3) -> list[Row]:
-    """Smallest SG force at which the dorsum region touches the palate (jaw at rest)."""
+def k_closure(model: Model, forces=(0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0, 4.0), duration: float = 0.3,
+              hold: bool = False) -> list[Row]:
+    """Smallest SG force at which the dorsum region touches the palate (jaw at rest; ``hold``: held there)."""
     rest = settle(model)
     dorsum_region = set(model.node_sets["dorsum_region"].tolist())
     dorsum = model.control_points()["dorsum"]
     audit = Audit(model)
     found, gap = None, None
     for force in forces:
-        traj, end = audit.run(rest, {"SG": force}, duration)
+        traj, end = audit.run(rest, {"SG": force}, duration, hold)
         if any(dorsum_region & set(c.tolist()) for c in traj.contact_nodes):
             found = force
             break
@@ -200,6 +207,7 @@ def fig7(model: Model, muscles=("GGp", "GGm", "SG"), forces=(1.0, 2.0, 3.5, 5.0)
 
 EXPERIMENTS = {"jaw-ep": jaw_ep, "fig4": fig4, "muscle-directions": muscle_directions, "k-closure": k_closure,
                "stress": stress, "fig7": fig7}
+HELD_JAW_EXPERIMENTS = ("muscle-directions", "k-closure")  # single EPs of tongue muscles: held as the maps are
 
 
 def rows_as_dicts(rows: list[Row]) -> list[dict]:

@@ -165,7 +165,7 @@ def build_body(cfg: Config, mesh: Mesh | None = None) -> Body:
         link(thyroid[s], (horn_l, horn_r)[s], "strap")
 
     # --- muscle routing ------------------------------------------------------------------
-    mid, sides = planes // 2, (0, planes - 1)
+    mid, sides = planes // 2, (planes - 1, 0)  # the left (+z) plane first, as bilateral() returns left, right
     chain = lambda pts: np.array(pts, dtype=np.int64)  # noqa: E731
     fib: dict[str, list[np.ndarray]] = {m: [] for m in TONGUE_MUSCLES + JAW_MUSCLES}
     radial = lambda k, p, j0=0, j1=nc - 1: chain([t(k, j, p) for j in range(j0, j1 + 1)])  # noqa: E731

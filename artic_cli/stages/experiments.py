@@ -12,23 +12,29 @@ import numpy as np
 
 from ..config import load_config
 from ..errors import ArticError
-from ..experiments.paper import EXPERIMENTS, Row, rows_as_dicts
+from ..experiments.paper import EXPERIMENTS, HELD_JAW_EXPERIMENTS, Row, rows_as_dicts
 from ..io.store import read_doc, write_doc
 from ..mechanics.model import ARTICULATOR_SECTIONS, Model
 from . import mesh as mesh_stage
 from .base import Stage, up_to_date
 from .simulate import build
 
-STAGE = Stage(name="experiments", module=__name__, sections=ARTICULATOR_SECTIONS, reads=("mesh",),
+STAGE = Stage(name="experiments", module=__name__, sections=(*ARTICULATOR_SECTIONS, "epmap"), reads=("mesh",),
               kind="experiment", hint="rerun 'artic experiment NAME --out FILE' (or 'make paper')")
 
 
-def compute(model: Model, name: str) -> tuple[list[Row], dict]:
-    """The experiment's rows and, for Fig. 7, its paths (cm) by muscle."""
+def compute(model: Model, name: str, hold_jaw: bool = False) -> tuple[list[Row], dict]:
+    """The experiment's rows and, for Fig. 7, its paths (cm) by muscle; ``hold_jaw`` (the EP maps' switch)
+    holds the jaw in the experiments made of single tongue-muscle EPs."""
     if name not in EXPERIMENTS:
         raise ArticError(f"unknown experiment '{name}'; valid: {', '.join(EXPERIMENTS)}")
     figure: dict = {}
-    rows = EXPERIMENTS[name](model, figure=figure) if name == "fig7" else EXPERIMENTS[name](model)
+    if name == "fig7":
+        rows = EXPERIMENTS[name](model, figure=figure)
+    elif name in HELD_JAW_EXPERIMENTS:
+        rows = EXPERIMENTS[name](model, hold=hold_jaw)
+    else:
+        rows = EXPERIMENTS[name](model)
     return rows, figure
 
 
@@ -66,10 +72,11 @@ def run_experiment(name: str, mesh: Path | str = "data/mesh.h5", config: Path | 
     cfg = load_config(config)
     m = mesh_stage.read(mesh, cfg)
     prov = STAGE.provenance(cfg, inputs={"mesh": m.content_sha256}, params={"experiment": name},
-                            code_roots=("artic_cli.experiments.paper",))
+                            code_roots=("artic_cli.experiments.paper",),
+                            sections=STAGE.sections if name in HELD_JAW_EXPERIMENTS else ARTICULATOR_SECTIONS)
     if out is not None and up_to_date(out, prov):
         return read(out)
-    rows, figure = compute(build(cfg, m.mesh, m.wall), name)
+    rows, figure = compute(build(cfg, m.mesh, m.wall), name, STAGE.view(cfg).epmap.hold_jaw)
     if out is not None:
         write(out, name, rows, figure, prov)
         return read(out)

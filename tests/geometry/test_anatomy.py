@@ -8,14 +8,7 @@ import pytest
 from artic_cli.geometry.anatomy import build_body
 
 
-CROSSING = ("known bug (issue 15): the left landmarks are joined to the right tongue plane (anatomy.py's `sides` "
-            "runs -z, +z against bilateral()'s left, right); fixed alone it lowers SG's Fig. 4 dorsum speed from "
-            "16.6 to 13.9 cm/s (paper 30), so it lands with the fidelity work")
-
-
-@pytest.mark.parametrize("muscle", [pytest.param("SG", marks=pytest.mark.xfail(strict=True, reason=CROSSING)),
-                                    pytest.param("HG", marks=pytest.mark.xfail(strict=True, reason=CROSSING)),
-                                    "IL", "MH", "GH", "posterior_digastric", "masseter"])
+@pytest.mark.parametrize("muscle", ["SG", "HG", "IL", "MH", "GH", "posterior_digastric", "masseter"])
 def test_a_bilateral_muscle_never_crosses_the_midline(cfg, muscle):
     body = build_body(cfg)
     sides = []
