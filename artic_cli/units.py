@@ -38,3 +38,13 @@ def s_to_ms(t):
 
 def erg_to_joule(e):
     return e / ERG_PER_J
+
+
+def hz_to_bark(f):
+    """Frequency (Hz) to the Bark scale, Traunmueller (1990, JASA 88): z = 26.81 f / (1960 + f) - 0.53."""
+    return 26.81 * f / (1960.0 + f) - 0.53
+
+
+def bark_to_hz(z):
+    """Inverse of :func:`hz_to_bark`."""
+    return 1960.0 * (z + 0.53) / (26.28 - z)

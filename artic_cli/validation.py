@@ -55,6 +55,7 @@ PositionCm = Finite
 LengthCm = Positive  # a tube's or a segment's length
 AreaCm2 = NonNegative  # a cross-sectional area: 0 is a closure
 F0Hz = Annotated[float, Field(ge=50, le=500, allow_inf_nan=False)]  # a voice's fundamental frequency
+FormantHz = Annotated[float, Field(ge=100, le=5000, allow_inf_nan=False)]  # a formant target
 SafeName = Annotated[str, AfterValidator(_safe_name)]  # a name that becomes a file name
 Point2 = Annotated[list[Finite], Field(min_length=2, max_length=2)]
 Point3 = Annotated[list[Finite], Field(min_length=3, max_length=3)]

@@ -509,21 +509,31 @@ def solve_target_cmd(
     budget: int = typer.Option(8, "--budget", help="Most simulations --refine may spend."),
     batch: Optional[Path] = typer.Option(None, "--batch", help="Solve every row of this CSV instead."),
     jobs: int = typer.Option(2, "--jobs", help="Parallel workers for --batch with --verify/--refine."),
-    mesh: Path = typer.Option(Path("data/mesh.h5"), "--mesh", help="Mesh for --verify / --refine."),
-    config: Optional[Path] = typer.Option(None, "--config", help="Config for --verify / --refine."),
+    mesh: Path = typer.Option(Path("data/mesh.h5"), "--mesh", help="Mesh for --verify / --refine and acoustic "
+                                                                   "targets."),
+    config: Optional[Path] = typer.Option(None, "--config", help="Config for --verify / --refine and acoustic "
+                                                                 "targets."),
+    acoustic_maps: Path = typer.Option(Path("data/acoustic_maps.h5"), "--acoustic-maps",
+                                       help="Formants of every EP from 'artic acoustic-map' (acoustic targets; "
+                                            "computed from the maps' shapes when absent or for other lips)."),
 ):
-    """Muscle forces that put the crucial feature on its target and approach the others (section V)."""
+    """Muscle forces that put the crucial feature (a place, or formants) on its target and approach the others
+    (section V; formant targets go beyond the paper)."""
     from ..control.targets import batch_csv, load_target, read_batch, solve_batch
     from ..io.store import write_text_atomic
-    from ..stages.solve import load_context, simulator, solve_target
+    from ..stages.solve import add_formants, load_context, simulator, solve_target
 
     if (target is None) == (batch is None):
         raise ArticError("give a target file or --batch CSV (one of them)")
     check_number("--budget", budget, ge=1)
     check_number("--jobs", jobs, ge=1)
     targets = read_batch(batch) if batch is not None else [load_target(target)]  # the user's file first
-    ctx = load_context(maps, dynamic, mesh if (verify or refine) else None)
-    sim = simulator(mesh, config) if (verify or refine) else None
+    acoustic = any(t.acoustic is not None for t in targets)
+    spatial = any(t.acoustic is None for t in targets)  # acoustic targets use the mapped jaw positions only
+    ctx = load_context(maps, dynamic if spatial else None, mesh if (verify or refine or acoustic) else None)
+    if acoustic:
+        add_formants(ctx, maps, mesh, config, acoustic_maps)
+    sim = simulator(mesh, config, voiced=acoustic) if (verify or refine) else None
     if batch is not None:
         args = None if sim is None else (sim.cfg, sim.mesh, sim.wall, sim.mesh_sha256)
         res = _with_progress("targets", lambda update: solve_batch(ctx, targets, jobs, args, verify, refine, budget,
@@ -539,6 +549,9 @@ def solve_target_cmd(
                                     "" if sim is None else sim.mesh_sha256)
     if fresh:
         out_console.print(f"{path} is up to date (same maps, target, options and code)", highlight=False)
+        return
+    if t.acoustic is not None:
+        _print_acoustic_solution(t, doc, path)
         return
     ch = doc["chosen"]
     forces = ", ".join(f"{k} {v:g} N" for k, v in ch["forces_n"].items())
@@ -559,6 +572,30 @@ def solve_target_cmd(
         err_console.print(f"target '{t.name}' not reached within {t.crucial.tolerance_cm:g} cm after "
                           f"{doc['refined']['simulations']} simulations (best {doc['refined']['crucial_error_cm']:.3f} "
                           f"cm, written to {path}); raise --budget or the tolerance", highlight=False)
+        raise typer.Exit(3)
+
+
+def _print_acoustic_solution(t, doc: dict, path: Path) -> None:
+    fmt = lambda f: ", ".join(f"F{k + 1} {v:.0f}" for k, v in enumerate(f[:3]))  # noqa: E731
+    ch = doc["chosen"]
+    forces = ", ".join(f"{k} {v:g} N" for k, v in ch["forces_n"].items()) or "no tongue force"
+    out_console.print(f"{t.name}: {ch['family']} {ch['map']}: {forces}; predicted {fmt(ch['predicted_formants_hz'])} "
+                      f"Hz (target {fmt(t.acoustic.formants_hz)} Hz; best of {doc['candidates_considered']} "
+                      "candidates)", highlight=False)
+    for key, label in (("verified", "verified by simulation"), ("refined", "refined")):
+        if key in doc:
+            r = doc[key]
+            head = (", ".join(f"{k} {v:g} N" for k, v in r["forces_n"].items()) + "; ") if "forces_n" in r else ""
+            out_console.print(f"{label}: {head}{fmt(r['formants_hz'])} Hz, errors "
+                              f"{', '.join(f'{e:+.1f} %' for e in r['errors_pct'])}"
+                              + (f" after {r['simulations']} simulations" if key == "refined" else ""),
+                              highlight=False)
+    out_console.print(f"wrote {path}", highlight=False)
+    last = doc.get("refined")
+    if last is not None and not last["converged"]:
+        err_console.print(f"target '{t.name}': F1/F2 not within {t.acoustic.tolerance_pct:g} % after "
+                          f"{last['simulations']} simulations (errors {', '.join(f'{e:+.1f} %' for e in last['errors_pct'])}, "
+                          f"written to {path}); raise --budget or the tolerance", highlight=False)
         raise typer.Exit(3)
 
 

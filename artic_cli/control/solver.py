@@ -23,11 +23,14 @@ names the nearest reachable point and its distance.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Annotated, Literal
 
 import numpy as np
 
-from ..validation import DEFAULT_MAX_FORCE_N, ForceN, NonNegative, Point2, Positive, PositionCm, SafeName, Strict, parse
+from pydantic import Field, field_validator
+
+from ..validation import (DEFAULT_MAX_FORCE_N, ForceN, FormantHz, NonNegative, Point2, Positive, PositionCm, SafeName,
+                          Strict, parse)
 from ..errors import ArticError, UnreachableTarget
 from .epmap import CONTROL_POINTS, JawMaps, Net
 
@@ -51,25 +54,70 @@ class Indecisive(Strict):
     weight: NonNegative = 1.0
 
 
+class AcousticGoal(Strict):
+    """A vowel's formants: F1 and F2 must come within ``tolerance_pct``; F3 (optional) is approached."""
+
+    formants_hz: Annotated[list[FormantHz], Field(min_length=2, max_length=3)]
+    tolerance_pct: Annotated[float, Field(gt=0, le=50, allow_inf_nan=False)] = 10.0
+    f3_weight: NonNegative = 0.3  # Bark^-2 relative to F1-F2's, in the choice among candidates
+
+    @field_validator("formants_hz")
+    @classmethod
+    def _increasing(cls, v):
+        if any(b <= a for a, b in zip(v, v[1:])):
+            raise ValueError("formants must increase (F1 < F2 < F3)")
+        return v
+
+
+class Lips(Strict):
+    area_cm2: Annotated[float, Field(gt=0, le=10, allow_inf_nan=False)]
+    length_cm: Annotated[float, Field(gt=0, le=4, allow_inf_nan=False)]
+
+
+# lip tubes by name (VocalTractLab's JD3 vowels, the sections its lips make: /o/ 1.53 cm, 0.40-0.82 cm^2;
+# /u/ 1.91 cm, 0.33-0.41 cm^2; /a/ /e/ /i/ 0.53-0.55 cm, 1.2-2.8 cm^2); "neutral" is the config's default
+LIP_SHAPES = {"rounded": Lips(area_cm2=0.6, length_cm=1.5), "compressed": Lips(area_cm2=0.37, length_cm=1.9),
+              "spread": Lips(area_cm2=2.5, length_cm=0.55)}
+
+
 class TargetSpec(Strict):
     name: SafeName = "target"  # becomes the solution's file name
     jaw: JawSpec = JawSpec(forces_n={"JO": 0.5})
-    crucial: Crucial
+    crucial: Crucial | None = None  # a place for a control point, or ...
+    acoustic: AcousticGoal | None = None  # ... formants (a vowel): one of the two
     indecisive: list[Indecisive] = []
+    lips: Lips | Literal["neutral", "rounded", "compressed", "spread"] | None = None  # acoustic targets only
+    velum_port_cm2: Annotated[float, Field(ge=0, le=5, allow_inf_nan=False)] | None = None
     force_weight: NonNegative = 1.0  # per N^2
     distance_weight: NonNegative = 100.0  # per cm^2
 
+    def lip_tube(self, default: tuple[float, float]) -> tuple[float, float]:
+        """(area cm^2, length cm) of the target's lips; ``default``: the config's."""
+        lips = LIP_SHAPES.get(self.lips) if isinstance(self.lips, str) else self.lips
+        return default if lips is None else (lips.area_cm2, lips.length_cm)
+
 
 def parse_target(data: object, source: str = "<target>", max_force_n: float = DEFAULT_MAX_FORCE_N) -> TargetSpec:
-    t = parse(TargetSpec, data, source, "target (with 'crucial', and 'jaw', 'indecisive')", "fix the target and rerun",
+    t = parse(TargetSpec, data, source, "target (with 'crucial' or 'acoustic', and 'jaw', 'indecisive')",
+              "fix the target and rerun",
               context={"max_force_n": max_force_n})
+    if (t.crucial is None) == (t.acoustic is None):
+        raise ArticError(f"{source}: give either 'crucial' (a control point's place) or 'acoustic' (formants), "
+                         "one of them")
+    if t.crucial is None and t.jaw.forces_n is None:
+        raise ArticError(f"{source}: key 'jaw': an acoustic target needs jaw.forces_n of a mapped jaw position "
+                         "(the acoustic maps hold the EPs' shapes only there)")
+    if t.crucial is not None and (t.lips is not None or t.velum_port_cm2 is not None):
+        raise ArticError(f"{source}: keys 'lips' and 'velum_port_cm2' belong to acoustic targets; remove them or "
+                         "give 'acoustic' instead of 'crucial'")
     if (t.jaw.forces_n is None) == (t.jaw.opening_cm is None):
         raise ArticError(f"{source}: key 'jaw': give either forces_n (JO or JC, N) or opening_cm")
     if t.jaw.forces_n is not None and t.jaw.forces_n.get("JO", 0) > 0 and t.jaw.forces_n.get("JC", 0) > 0:
         raise ArticError(f"{source}: key 'jaw.forces_n': give JO or JC, not both")
-    points = [t.crucial.point] + [i.point for i in t.indecisive]
+    points = ([t.crucial.point] if t.crucial is not None else []) + [i.point for i in t.indecisive]
     if len(set(points)) != len(points):
-        raise ArticError(f"{source}: key 'indecisive': each control point once (the crucial one is {t.crucial.point})")
+        raise ArticError(f"{source}: key 'indecisive': each control point once"
+                         + (f" (the crucial one is {t.crucial.point})" if t.crucial is not None else ""))
     return t
 
 
@@ -137,8 +185,17 @@ def _cells(net2: np.ndarray, conv: np.ndarray):
     return ii, jj, corners[..., :2, :2]  # tip and dorsum, x and y
 
 
+def indecisive_cost(target: TargetSpec, forces: dict[str, float], pred: np.ndarray) -> float:
+    """force_weight * sum F^2 + distance_weight * sum w |p - target|^2 over the indecisive features;
+    pred: (2, 2) predicted tip and dorsum (x, y)."""
+    f = target.force_weight * sum(v * v for v in forces.values())
+    d = sum(i.weight * float(np.sum((pred[CONTROL_POINTS.index(i.point)] - np.asarray(i.at_cm)) ** 2))
+            for i in target.indecisive)
+    return float(f + target.distance_weight * d)
+
+
 class Problem:
-    """A target on the maps of one jaw position."""
+    """A spatial target on the maps of one jaw position."""
 
     def __init__(self, jm: JawMaps, target: TargetSpec, reach: float | None = None):
         self.jm = jm
@@ -148,11 +205,7 @@ class Problem:
         self.goal = np.asarray(target.crucial.at_cm, dtype=float)
 
     def cost(self, forces: dict[str, float], pred: np.ndarray) -> float:
-        """pred: (2, 2) predicted tip and dorsum (x, y)."""
-        f = self.t.force_weight * sum(v * v for v in forces.values())
-        d = sum(i.weight * float(np.sum((pred[CONTROL_POINTS.index(i.point)] - np.asarray(i.at_cm)) ** 2))
-                for i in self.t.indecisive)
-        return float(f + self.t.distance_weight * d)
+        return indecisive_cost(self.t, forces, pred)
 
     def _candidate(self, family, name, forces, pred, detail) -> Candidate:
         forces = {k: float(v) for k, v in forces.items() if v > 1e-12}

@@ -7,6 +7,7 @@ import io
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
@@ -23,12 +24,18 @@ REFINE_TRIES = 3  # candidates --refine may try in turn
 
 @dataclass
 class Context:
-    """What a target is solved on: the EP maps and (optionally) the dynamic map, with their content hashes."""
+    """What a target is solved on: the EP maps and (optionally) the dynamic map, with their content hashes;
+    for acoustic targets ``formants(jaw, lip_area_cm2, lip_length_cm, velum_port_cm2)`` gives the formants
+    of every EP at a mapped jaw position (``FormantNets``), and ``lips_default`` the config's lip tube."""
 
     maps: EPMaps
     dm: DynamicMap | None
     maps_sha256: str = ""
     dynamic_sha256: str | None = None
+    formants: Callable[[str, float, float, float], dict] | None = None
+    lips_default: tuple[float, float] = (3.0, 1.0)  # area cm^2, length cm
+    port_default: float = 0.0  # cm^2
+    acoustic_sha256: str | None = None  # the acoustic maps' content, when they gave the formants
 
 
 def jaw_maps(ctx: Context, target: TargetSpec) -> tuple[JawMaps, dict[str, float], float, str]:
@@ -78,9 +85,116 @@ def _cand(c: Candidate) -> dict:
             "crucial_error_cm": _num(c.crucial_error), "cost": _num(c.cost)}
 
 
+def mapped_jaw(ctx: Context, target: TargetSpec) -> tuple[str, JawMaps]:
+    """The mapped jaw position whose forces are the target's (acoustic targets need the EPs' shapes)."""
+    want = canonical(dict(target.jaw.forces_n or {}))
+    for name, jm in ctx.maps.jaws.items():
+        if canonical(jm.forces) == want:
+            return name, jm
+    have = ", ".join(f"{n} ({' '.join(f'{k} {v:g} N' for k, v in jm.forces.items()) or 'no force'})"
+                     for n, jm in ctx.maps.jaws.items())
+    raise ArticError(f"target '{target.name}': jaw forces {dict(target.jaw.forces_n or {})} are not a mapped jaw "
+                     f"position; an acoustic target needs one of: {have}")
+
+
+def _formant_doc(target: TargetSpec, f_hz, extra: dict | None = None) -> dict:
+    from .acoustic_solver import errors_pct, within
+
+    d = {"formants_hz": [_num(v) for v in f_hz], "errors_pct": errors_pct(target, f_hz),
+         "within_tolerance": within(target, f_hz)}
+    if extra:
+        d.update(extra)
+    return d
+
+
+def solve_acoustic(ctx: Context, target: TargetSpec, voicer=None, verify: bool = False, refine: bool = False,
+                   budget: int = 8) -> dict:
+    """An acoustic target: candidates from the EPs' formants, checked (``verify``) or corrected (``refine``)
+    by ``voicer.voice(jaw_forces, forces, lips, port) -> dict(formants_hz, reached_cm, area_function)``."""
+    from .acoustic_solver import nearest_candidate, solve_acoustic_on, within
+    from .verify import _free, _map_jacobian, broyden
+    from ..units import hz_to_bark
+
+    if ctx.formants is None:
+        raise ArticError(f"target '{target.name}': acoustic targets need the formants of the maps' EPs; give "
+                         "--acoustic-maps (from 'artic acoustic-map') or --mesh and --config")
+    jaw, jm = mapped_jaw(ctx, target)
+    lips = target.lip_tube(ctx.lips_default)
+    port = ctx.port_default if target.velum_port_cm2 is None else float(target.velum_port_cm2)
+    formants = ctx.formants(jaw, lips[0], lips[1], port)
+    head = {"target": target.name,
+           "jaw": {"forces_n": {k: _num(v) for k, v in jm.forces.items()}, "incisor_height_cm": _num(jm.rest[2, 1]),
+                   "maps": f"simulated maps of jaw position {jaw}"},
+           "acoustic": {"formants_hz": [float(v) for v in target.acoustic.formants_hz],
+                        "tolerance_pct": target.acoustic.tolerance_pct},
+           "lips": {"area_cm2": _num(lips[0]), "length_cm": _num(lips[1])}, "velum_port_cm2": _num(port)}
+    def voiced_cand(c: Candidate) -> dict:
+        d = _cand(c)
+        d.pop("crucial_error_cm")
+        return dict(d, predicted_formants_hz=[_num(v) for v in c.detail["formants_hz"]], bark_error=_num(c.crucial_error))
+
+    try:
+        cands = solve_acoustic_on(jm, target, formants, widen=refine)
+    except UnreachableTarget as err:  # the answer is still the nearest force set the maps know
+        near = nearest_candidate(jm, target, formants)
+        if near is not None:
+            err.answer = dict(head, nearest=voiced_cand(near))
+        raise
+    chosen = cands[0]
+    doc = dict(head, chosen=voiced_cand(chosen), candidates=[voiced_cand(c) for c in cands[:TOP]],
+               candidates_considered=len(cands))
+    if not (verify or refine):
+        return doc
+    jaw_forces = dict(jm.forces)
+
+    def voiced(forces):
+        return voicer.voice(jaw_forces, forces, lips, port)
+
+    first = voiced(chosen.forces)
+    doc["verified"] = _formant_doc(target, first["formants_hz"], {"reached_cm": first["reached_cm"],
+                                                                  "area_function": first["area_function"],
+                                                                  "simulations": 1})
+    if not refine:
+        return doc
+    goal = hz_to_bark(np.asarray(target.acoustic.formants_hz[:2], dtype=float))
+
+    def measure(forces):
+        v = voiced(forces)
+        f = np.asarray(v["formants_hz"], dtype=float)[:2]
+        feat = hz_to_bark(f) if np.all(np.isfinite(f)) else np.full(2, -10.0)  # a closed tract: far off
+        return feat, v
+
+    def feature(family, name, x):
+        return hz_to_bark(formants[f"{family}/{name}"][..., :2])
+
+    left, best, tried = budget - 1, None, []
+    for k, cand in enumerate(cands[:REFINE_TRIES]):
+        if k > 0 and left < 2:
+            break
+        free = _free(cand)
+        r = broyden(measure, _map_jacobian(jm, cand, free, feature), cand.forces, free, goal,
+                    lambda e, v: within(target, v["formants_hz"]), left,
+                    first=(measure(cand.forces) if k > 0 else (hz_to_bark(np.asarray(first["formants_hz"][:2])), first)))
+        left -= r.simulations + (1 if k > 0 else 0)
+        tried.append(f"{cand.family} {cand.name}")
+        if best is None or r.error < best[0].error:
+            best = (r, cand)
+        if within(target, r.extra["formants_hz"]):
+            break
+    r, cand = best
+    doc["refined"] = _formant_doc(target, r.extra["formants_hz"], {
+        "from": f"{cand.family} {cand.name}", "candidates_tried": tried,
+        "forces_n": {k: _num(v) for k, v in r.forces.items()}, "reached_cm": r.extra["reached_cm"],
+        "area_function": r.extra["area_function"], "bark_error": _num(r.error), "simulations": budget - left,
+        "converged": within(target, r.extra["formants_hz"])})
+    return doc
+
+
 def solve(ctx: Context, target: TargetSpec, simulator=None, verify: bool = False, refine: bool = False,
           budget: int = 8) -> dict:
     """Solve one target; returns the result document (plain data, units in the keys)."""
+    if target.acoustic is not None:
+        return solve_acoustic(ctx, target, simulator, verify, refine, budget)
     jm, jaw_forces, height, how = jaw_maps(ctx, target)
     cands = solve_on(jm, target, REFINE_REACH_CM if refine else None)
     chosen = cands[0]

@@ -21,7 +21,7 @@ from ..geometry.wall import WallSurface
 from ..io.fingerprint import code_hash, digest, sections_hash
 from ..mechanics.model import ARTICULATOR_SECTIONS, CONTROL_POINTS
 from .epmap import JawMaps, add_forces, canonical
-from .equilibrium import equilibrium_point, worker_model, worker_rest
+from .equilibrium import equilibrium_point, equilibrium_state, worker_model, worker_rest
 from .solver import Candidate
 
 MAX_STEP_N = 1.5  # largest change of one force per refinement step
@@ -43,6 +43,18 @@ class Simulator:
         start = worker_rest(self.key, canonical(jaw_forces), self.cfg_json, self.mesh, self.wall)
         return equilibrium_point(model, start, add_forces(dict(jaw_forces), forces), self.cfg.epmap).x
 
+    def shape(self, jaw_forces: dict[str, float], forces: dict[str, float]) -> tuple[np.ndarray, np.ndarray]:
+        """The whole shape (N, 3) and the control points (3, 3) after holding the forces, as :meth:`reach`;
+        also the model's rest and the mandible's nodes (what a vocal tract needs)."""
+        model = worker_model(self.key, self.cfg_json, self.mesh, self.wall)
+        start = worker_rest(self.key, canonical(jaw_forces), self.cfg_json, self.mesh, self.wall)
+        state, ep = equilibrium_state(model, start, add_forces(dict(jaw_forces), forces), self.cfg.epmap)
+        return state.x, ep.x
+
+    def model_rest(self) -> tuple[np.ndarray, np.ndarray]:
+        model = worker_model(self.key, self.cfg_json, self.mesh, self.wall)
+        return model.rest, np.asarray(model.node_sets["mandible"])
+
 
 @dataclass
 class Refinement:
@@ -61,41 +73,51 @@ def _free(candidate: Candidate) -> list[str]:
     return [a, b]
 
 
-def _map_jacobian(jm: JawMaps, candidate: Candidate, c: int, free: list[str]) -> np.ndarray:
-    """d(crucial point)/d(free forces) (2, n) from the map around the candidate."""
+def _map_jacobian(jm: JawMaps, candidate: Candidate, free: list[str], feature) -> np.ndarray:
+    """d(feature)/d(free forces) (2, n) from the map around the candidate; ``feature(family, net_name, x)``
+    gives the (..., 2) feature of a net's EPs (x: the net's control points)."""
     if candidate.family == "single":
         net = jm.single[free[0]]
         k = candidate.detail["segment"]
-        dp = net.x[k + 1, c, :2] - net.x[k, c, :2]
-        return (dp / (net.levels[0][k + 1] - net.levels[0][k]))[:, None]
+        f = feature("single", free[0], net.x)
+        return ((f[k + 1] - f[k]) / (net.levels[0][k + 1] - net.levels[0][k]))[:, None]
     name = candidate.detail["net"]
+    family = "pair" if name in jm.pair else "group"
     net = jm.pair.get(name) or jm.group[name]
-    x, levels = net.x, net.levels
+    f, levels = feature(family, name, net.x), net.levels
     if candidate.family == "group":
         fixed = candidate.detail["fixed"][1]
         k = int(np.argmin(np.abs(levels[0] - fixed)))
-        x, levels = x[k], levels[1:]
+        f, levels = f[k], levels[1:]
     i, j = candidate.detail["cell"]
     u, v = candidate.detail["uv"]
-    p00, p10, p01, p11 = x[i, j, c, :2], x[i + 1, j, c, :2], x[i, j + 1, c, :2], x[i + 1, j + 1, c, :2]
+    p00, p10, p01, p11 = f[i, j], f[i + 1, j], f[i, j + 1], f[i + 1, j + 1]
     du = (1 - v) * (p10 - p00) + v * (p11 - p01)
     dv = (1 - u) * (p01 - p00) + u * (p11 - p10)
     return np.column_stack([du / (levels[0][i + 1] - levels[0][i]), dv / (levels[1][j + 1] - levels[1][j])])
 
 
-def refine(sim: Simulator, jm: JawMaps, jaw_forces: dict[str, float], candidate: Candidate, crucial: str,
-           goal: np.ndarray, tolerance: float, budget: int = 8, first: np.ndarray | None = None) -> Refinement:
-    """Correct the candidate's free forces until the simulated crucial point is within ``tolerance``."""
-    c = CONTROL_POINTS.index(crucial)
-    forces = dict(candidate.forces)
-    free = _free(candidate)
-    jac = _map_jacobian(jm, candidate, c, free)
-    reached = sim.reach(jaw_forces, forces) if first is None else first
+@dataclass
+class Correction:
+    forces: dict[str, float]
+    feature: np.ndarray  # the measured feature of the best force set
+    extra: object  # what the measurement gave besides the feature (for the best force set)
+    error: float  # distance of the feature from the goal
+    simulations: int
+    history: list[dict] = field(default_factory=list)
+
+
+def broyden(measure, jac: np.ndarray, forces: dict[str, float], free: list[str], goal: np.ndarray, done,
+            budget: int, first=None) -> Correction:
+    """Quasi-Newton on the free forces until ``done(error, extra)``: ``measure(forces) -> (feature, extra)``
+    simulates; the first Jacobian is given (from the maps), later ones come from Broyden's update."""
+    forces = dict(forces)
+    feat, extra = measure(forces) if first is None else first
     sims = 1 if first is None else 0
-    err = goal - reached[c, :2]
-    history = [{"forces_n": dict(forces), "error_cm": float(np.linalg.norm(err))}]
-    best = (float(np.linalg.norm(err)), dict(forces), reached)
-    while best[0] > tolerance and sims < budget:
+    err = goal - feat
+    history = [{"forces_n": dict(forces), "error": float(np.linalg.norm(err))}]
+    best = Correction(dict(forces), feat, extra, float(np.linalg.norm(err)), sims, history)
+    while not done(best.error, best.extra) and sims < budget:
         step, *_ = np.linalg.lstsq(jac, err, rcond=None)
         step = np.clip(step, -MAX_STEP_N, MAX_STEP_N)
         f = np.array([forces.get(m, 0.0) for m in free])
@@ -105,13 +127,29 @@ def refine(sim: Simulator, jm: JawMaps, jaw_forces: dict[str, float], candidate:
             break
         trial = dict(forces)
         trial.update({m: float(v) for m, v in zip(free, new)})
-        got = sim.reach(jaw_forces, trial)
+        got, got_extra = measure(trial)
         sims += 1
-        new_err = goal - got[c, :2]
-        dr = got[c, :2] - reached[c, :2]
-        jac = jac + np.outer(dr - jac @ step, step) / float(step @ step)  # Broyden
-        forces, reached, err = trial, got, new_err
-        history.append({"forces_n": dict(forces), "error_cm": float(np.linalg.norm(err))})
-        if np.linalg.norm(err) < best[0]:
-            best = (float(np.linalg.norm(err)), dict(forces), reached)
-    return Refinement(forces=best[1], reached=best[2], error=best[0], simulations=sims, history=history)
+        jac = jac + np.outer((got - feat) - jac @ step, step) / float(step @ step)  # Broyden
+        forces, feat, extra, err = trial, got, got_extra, goal - got
+        history.append({"forces_n": dict(forces), "error": float(np.linalg.norm(err))})
+        if np.linalg.norm(err) < best.error:
+            best = Correction(dict(forces), feat, extra, float(np.linalg.norm(err)), sims, history)
+    best.simulations, best.history = sims, history
+    return best
+
+
+def refine(sim: Simulator, jm: JawMaps, jaw_forces: dict[str, float], candidate: Candidate, crucial: str,
+           goal: np.ndarray, tolerance: float, budget: int = 8, first: np.ndarray | None = None) -> Refinement:
+    """Correct the candidate's free forces until the simulated crucial point is within ``tolerance``."""
+    c = CONTROL_POINTS.index(crucial)
+    free = _free(candidate)
+    jac = _map_jacobian(jm, candidate, free, lambda family, name, x: x[..., c, :2])
+
+    def measure(forces):
+        x = sim.reach(jaw_forces, forces)
+        return x[c, :2], x
+
+    r = broyden(measure, jac, candidate.forces, free, goal, lambda e, _: e <= tolerance, budget,
+                None if first is None else (first[c, :2], first))
+    history = [{"forces_n": h["forces_n"], "error_cm": h["error"]} for h in r.history]
+    return Refinement(forces=r.forces, reached=r.extra, error=r.error, simulations=r.simulations, history=history)

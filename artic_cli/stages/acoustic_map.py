@@ -51,11 +51,13 @@ class AcousticMaps:
         return np.concatenate([n.formants_hz.reshape(-1, FORMANTS) for n in self.jaws[jaw].values()])
 
 
-def _net(vt, cfg, mesh, maps, shapes: np.ndarray) -> NetAcoustics:
+def net_acoustics(vt, cfg, mesh, model_rest: np.ndarray, mandible_nodes: np.ndarray, shapes: np.ndarray,
+                  overrides: dict | None = None) -> NetAcoustics:
+    """Tracts and formants of a grid of shapes (*grid, N, 3); ``overrides``: lip tube and port controls."""
     grid = shapes.shape[:-2]
     flat = shapes.reshape(-1, *shapes.shape[-2:]).astype(float)
-    sh = vt_stage.shapes_of(flat, np.zeros(len(flat)), mesh, maps.model_rest, maps.mandible_nodes)
-    t = vt_stage.compute(vt, cfg.speaker.wall, sh, vt_stage.controls_for(vt, sh.time_s))
+    sh = vt_stage.shapes_of(flat, np.zeros(len(flat)), mesh, model_rest, mandible_nodes)
+    t = vt_stage.compute(vt, cfg.speaker.wall, sh, vt_stage.controls_for(vt, sh.time_s, overrides=overrides))
     tubes = [Tube(t.af.length_cm[k], t.af.area_cm2[k]) for k in range(t.n_frames)]
     ports = acoustics_stage.port_positions(t)
     ac = acoustics_stage.compute(tubes, cfg, velum_area_cm2=t.controls["velum_port_cm2"], port_from_glottis_cm=ports)
@@ -65,22 +67,25 @@ def _net(vt, cfg, mesh, maps, shapes: np.ndarray) -> NetAcoustics:
                         min_area_cm2=t.af.area_cm2.min(axis=1).reshape(grid))
 
 
-def compute(cfg, mesh, maps, progress: Callable[[int, int], None] | None = None) -> AcousticMaps:
+def compute(cfg, mesh, maps, progress: Callable[[int, int], None] | None = None, jaws: list[str] | None = None,
+            overrides: dict | None = None) -> AcousticMaps:
+    """Every EP's acoustics (``jaws``: those jaw positions only; ``overrides``: lip tube and port)."""
     vt = vt_stage.speaker_tract(cfg)
     if maps.model_rest is None or any(jm.rest_shape is None for jm in maps.jaws.values()):
         raise ArticError("the EP maps keep no shapes (an older artic built them); rerun 'artic ep-map'")
-    jobs = [(jname, "rest", jm.rest_shape[None]) for jname, jm in maps.jaws.items()]
-    for jname, jm in maps.jaws.items():
+    chosen = {j: jm for j, jm in maps.jaws.items() if jaws is None or j in jaws}
+    jobs = [(jname, "rest", jm.rest_shape[None]) for jname, jm in chosen.items()]
+    for jname, jm in chosen.items():
         for fam in ("single", "pair", "group"):
             for name, net in getattr(jm, fam).items():
                 jobs.append((jname, f"{fam}/{name}", net.shapes))
-    out: dict[str, dict[str, NetAcoustics]] = {j: {} for j in maps.jaws}
+    out: dict[str, dict[str, NetAcoustics]] = {j: {} for j in chosen}
     total = sum(int(np.prod(s.shape[:-2])) for _, _, s in jobs)
     done = 0
     for jname, key, shapes in jobs:
         if progress is not None:
             progress(done, total)
-        out[jname][key] = _net(vt, cfg, mesh, maps, shapes)
+        out[jname][key] = net_acoustics(vt, cfg, mesh, maps.model_rest, maps.mandible_nodes, shapes, overrides)
         done += int(np.prod(shapes.shape[:-2]))
     if progress is not None:
         progress(total, total)

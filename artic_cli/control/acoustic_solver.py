@@ -1,0 +1,195 @@
+"""Acoustic targets on the EP maps: force sets whose vocal tract has the target's formants.
+
+Every EP of the maps has formants (the acoustic maps, or the same computed for the target's lips and
+velopharyngeal port).  The search is the spatial solver's with the crucial point replaced by (F1, F2) on the
+Bark scale (Traunmueller 1990), a perceptual distance: along single-muscle vectors, inside two-muscle nets and
+inside each co-contraction level of the three-muscle groups (bilinear in each cell, inverted exactly).  A
+candidate counts when F1 and F2 are each within the tolerance (per cent of the target); F3, when given, is
+approached.  Among those the cheapest wins: forces^2, the indecisive features' distances (as the spatial
+solver) and F3's Bark error.  Formants are interpolated linearly between EPs: a refinement by simulation
+(:func:`..verify.refine_formants`) corrects what that misses.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import UnreachableTarget
+from ..units import hz_to_bark
+from .epmap import JawMaps
+from .solver import Candidate, TargetSpec, _bilinear, _polyline_nearest, _settled_run, indecisive_cost, invert_cells
+
+FormantNets = dict  # "single/SG" | "pair/A+B" | "group/I+A+B" -> (*grid, K) formants of the net's EPs, Hz
+
+
+def within(target: TargetSpec, formants_hz) -> bool:
+    """F1 and F2 each within the target's tolerance."""
+    f = np.asarray(formants_hz, dtype=float)[:2]
+    goal = np.asarray(target.acoustic.formants_hz[:2])
+    return bool(np.all(np.isfinite(f)) and np.all(np.abs(f / goal - 1.0) <= target.acoustic.tolerance_pct / 100))
+
+
+def errors_pct(target: TargetSpec, formants_hz) -> list[float]:
+    goal = np.asarray(target.acoustic.formants_hz, dtype=float)
+    f = np.asarray(formants_hz, dtype=float)[: len(goal)]
+    return [round(float(100 * (a / b - 1.0)), 2) for a, b in zip(f, goal)]
+
+
+class AcousticProblem:
+    """An acoustic target on the maps (and formants) of one jaw position."""
+
+    def __init__(self, jm: JawMaps, target: TargetSpec, formants: FormantNets, reach: float = 1.0):
+        self.jm, self.t, self.formants = jm, target, formants
+        goal = np.asarray(target.acoustic.formants_hz, dtype=float)
+        self.goal_hz = goal
+        self.goal = hz_to_bark(goal[:2])
+        tol = target.acoustic.tolerance_pct / 100
+        box = hz_to_bark(goal[:2] * (1 + tol)) - self.goal  # the tolerance in Bark, per formant
+        self.reach = reach * float(np.hypot(*box))  # cells and vectors searched within this Bark distance
+
+    def cost(self, forces: dict[str, float], pred: np.ndarray, f_hz: np.ndarray) -> float:
+        c = indecisive_cost(self.t, forces, pred)
+        if len(self.goal_hz) > 2 and np.isfinite(f_hz[2]):
+            c += self.t.acoustic.f3_weight * self.t.distance_weight * float(hz_to_bark(f_hz[2]) -
+                                                                            hz_to_bark(self.goal_hz[2])) ** 2
+        return c
+
+    def _candidate(self, family, name, forces, pred, f_hz, detail) -> Candidate:
+        forces = {k: float(v) for k, v in forces.items() if v > 1e-12}
+        err = float(np.linalg.norm(hz_to_bark(f_hz[:2]) - self.goal))
+        detail = dict(detail, formants_hz=[float(v) for v in f_hz])
+        return Candidate(family=family, name=name, forces=forces,
+                         predicted={cp: [float(pred[k, 0]), float(pred[k, 1])] for k, cp in enumerate(("tip", "dorsum"))},
+                         crucial_error=err, cost=self.cost(forces, pred, f_hz), detail=detail)
+
+    def singles(self) -> list[Candidate]:
+        out = []
+        for m, net in self.jm.single.items():
+            f = self.formants.get(f"single/{m}")
+            stop = _settled_run(net)
+            if f is None or stop < 2:
+                continue
+            f = f[:stop]
+            ok = np.isfinite(f[:, :2]).all(axis=1)
+            if not ok.all():  # a closed tract ends the usable part of the vector
+                stop = int(np.argmin(ok)) if not ok[0] else 0
+                if stop < 2:
+                    continue
+                f = f[:stop]
+            d, k, frac = _polyline_nearest(hz_to_bark(f[:, :2]), self.goal)
+            if d > self.reach:
+                continue
+            lv = net.levels[0]
+            force = lv[k] + frac * (lv[k + 1] - lv[k])
+            pts = net.x[:stop, :2, :2]
+            pred = pts[k] + frac * (pts[k + 1] - pts[k])
+            f_hz = f[k] + frac * (f[k + 1] - f[k])
+            out.append(self._candidate("single", m, {m: force}, pred, f_hz, {"segment": k, "fraction": frac}))
+        return out
+
+    def _nets(self):
+        for name, net in self.jm.pair.items():
+            f = self.formants.get(f"pair/{name}")
+            if f is not None:
+                yield "pair", name, net.muscles, None, net.levels, net.x, net.converged, f
+        for name, net in self.jm.group.items():
+            f = self.formants.get(f"group/{name}")
+            if f is None:
+                continue
+            for k in range(1, len(net.levels[0])):  # level 0 of a group is its pair net
+                yield ("group", name, net.muscles, (net.muscles[0], float(net.levels[0][k])), net.levels[1:],
+                       net.x[k], net.converged[k], f[k])
+
+    @staticmethod
+    def _cells(x: np.ndarray, conv: np.ndarray, f: np.ndarray):
+        """Cells whose four corners settled and have F1 and F2: indices, control-point corners (C, 4, 4) and
+        formant corners (C, 4, K)."""
+        na, nb = conv.shape
+        ii, jj = (g.ravel() for g in np.meshgrid(np.arange(na - 1), np.arange(nb - 1), indexing="ij"))
+        good = conv & np.isfinite(f[..., :2]).all(axis=-1)
+        ok = good[ii, jj] & good[ii + 1, jj] & good[ii, jj + 1] & good[ii + 1, jj + 1]
+        ii, jj = ii[ok], jj[ok]
+        pick = lambda a: np.stack([a[ii, jj], a[ii + 1, jj], a[ii, jj + 1], a[ii + 1, jj + 1]], axis=1)  # noqa: E731
+        return ii, jj, pick(x[..., :2, :2]).reshape(len(ii), 4, 4), pick(f)
+
+    def nets(self) -> list[Candidate]:
+        out = []
+        for family, name, muscles, fixed, levels, x, conv, f in self._nets():
+            ii, jj, cp, fc = self._cells(x, conv, f)
+            if not len(ii):
+                continue
+            bark = hz_to_bark(fc[..., :2])
+            u, v, _ = invert_cells(bark, self.goal)
+            u, v = np.clip(u, 0.0, 1.0), np.clip(v, 0.0, 1.0)
+            res = np.linalg.norm(_bilinear(bark, u, v) - self.goal, axis=1)
+            for k in np.flatnonzero(res <= self.reach):
+                a, b = muscles[-2], muscles[-1]
+                la, lb = levels
+                forces = {a: la[ii[k]] + u[k] * (la[ii[k] + 1] - la[ii[k]])}
+                forces[b] = forces.get(b, 0.0) + lb[jj[k]] + v[k] * (lb[jj[k] + 1] - lb[jj[k]])
+                if fixed is not None:
+                    forces[fixed[0]] = forces.get(fixed[0], 0.0) + fixed[1]
+                uu, vv = np.array([u[k]]), np.array([v[k]])
+                pred = _bilinear(cp[k][None], uu, vv)[0].reshape(2, 2)
+                f_hz = _bilinear(fc[k][None], uu, vv)[0]
+                label = name if fixed is None else f"{name} ({fixed[0]} {fixed[1]:g} N)"
+                out.append(self._candidate(family, label, forces, pred, f_hz,
+                                           {"cell": [int(ii[k]), int(jj[k])], "uv": [float(u[k]), float(v[k])],
+                                            "net": name, "fixed": fixed}))
+        return out
+
+    def nearest(self) -> tuple[np.ndarray | None, float, str]:
+        """The mapped formants (Hz) nearest the target in Bark (vectors exactly, net cells sampled)."""
+        best: tuple = (None, np.inf, "")
+        for m, net in self.jm.single.items():
+            f = self.formants.get(f"single/{m}")
+            if f is None:
+                continue
+            f = f[: _settled_run(net)]
+            f = f[np.isfinite(f[:, :2]).all(axis=1)]
+            if len(f) < 2:
+                continue
+            d, k, frac = _polyline_nearest(hz_to_bark(f[:, :2]), self.goal)
+            if d < best[1]:
+                best = (f[k] + frac * (f[k + 1] - f[k]), d, f"vector {m}")
+        s = np.linspace(0, 1, 9)
+        uu, vv = (g.ravel() for g in np.meshgrid(s, s, indexing="ij"))
+        for family, name, _, fixed, _, x, conv, f in self._nets():
+            _, _, _, fc = self._cells(x, conv, f)
+            if not len(fc):
+                continue
+            c = np.repeat(fc[:, None], len(uu), axis=1)  # (C, S, 4, K)
+            p = _bilinear(c, np.broadcast_to(uu, c.shape[:2]), np.broadcast_to(vv, c.shape[:2]))
+            d = np.linalg.norm(hz_to_bark(p[..., :2]) - self.goal, axis=-1)
+            k = np.unravel_index(np.argmin(d), d.shape)
+            if d[k] < best[1]:
+                label = name if fixed is None else f"{name} ({fixed[0]} {fixed[1]:g} N)"
+                best = (p[k], float(d[k]), f"{family} {label}")
+        return best
+
+
+def solve_acoustic_on(jm: JawMaps, target: TargetSpec, formants: FormantNets, widen: bool = False) -> list[Candidate]:
+    """Every candidate whose interpolated F1 and F2 are within tolerance, cheapest first.  With ``widen`` (a
+    refinement follows) and none within, the ones within twice the tolerance's Bark distance, nearest first."""
+    p = AcousticProblem(jm, target, formants, reach=2.0 if widen else 1.0)
+    found = p.singles() + p.nets()
+    cands = sorted([c for c in found if within(target, c.detail["formants_hz"])], key=lambda c: c.cost)
+    if not cands and widen:
+        cands = sorted(found, key=lambda c: (c.crucial_error, c.cost))
+    if not cands:
+        f, dist, where = p.nearest()
+        if f is None:
+            raise UnreachableTarget(f"target '{target.name}': no settled EPs with formants to search")
+        goal = target.acoustic.formants_hz
+        raise UnreachableTarget(
+            f"target '{target.name}': F1 {goal[0]:g} Hz, F2 {goal[1]:g} Hz are not reachable at this jaw position "
+            f"with these lips; the nearest mapped formants are F1 {f[0]:.0f} Hz, F2 {f[1]:.0f} Hz ({where}), "
+            f"{dist:.2f} Bark away (F1 {100 * (f[0] / goal[0] - 1):+.1f} %, F2 {100 * (f[1] / goal[1] - 1):+.1f} %)")
+    return cands
+
+
+def nearest_candidate(jm: JawMaps, target: TargetSpec, formants: FormantNets) -> Candidate | None:
+    """The force set whose interpolated formants come nearest the target (in Bark), however far."""
+    p = AcousticProblem(jm, target, formants, reach=np.inf)
+    found = p.singles() + p.nets()
+    return min(found, key=lambda c: (c.crucial_error, c.cost)) if found else None

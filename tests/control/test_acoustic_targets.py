@@ -1,0 +1,117 @@
+"""Acoustic targets (issue 16): formants in, muscle forces out, checked and refined by simulation."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+import yaml
+
+from artic_cli.control.acoustic_solver import solve_acoustic_on, within
+from artic_cli.control.epmap import JawMaps, Net
+from artic_cli.control.solver import parse_target
+from artic_cli.errors import ArticError, UnreachableTarget
+from artic_cli.stages.epmap import build_ep_maps
+from artic_cli.stages.solve import add_formants, load_context, simulator, solve_target
+
+from conftest import ROOT
+
+
+def _acoustic(formants, tol=5.0, **extra):
+    return parse_target({"name": "v", "jaw": {"forces_n": {}}, "acoustic": {"formants_hz": list(formants),
+                                                                           "tolerance_pct": tol}, **extra})
+
+
+@pytest.mark.parametrize("data,needle", [
+    ({"acoustic": {"formants_hz": [500, 1500]}, "crucial": {"point": "tip", "at_cm": [0, 0]}}, "one of them"),
+    ({}, "give either 'crucial'"),
+    ({"acoustic": {"formants_hz": [1500, 500]}}, "formants must increase"),
+    ({"acoustic": {"formants_hz": [500, float("nan")]}}, "acoustic.formants_hz"),
+    ({"acoustic": {"formants_hz": [500]}}, "acoustic.formants_hz"),
+    ({"acoustic": {"formants_hz": [500, 1500], "tolerance_pct": 0}}, "acoustic.tolerance_pct"),
+    ({"acoustic": {"formants_hz": [500, 1500]}, "lips": "pursed"}, "lips"),
+    ({"acoustic": {"formants_hz": [500, 1500]}, "lips": {"area_cm2": -1, "length_cm": 1}}, "lips"),
+    ({"acoustic": {"formants_hz": [500, 1500]}, "jaw": {"opening_cm": -0.3}}, "mapped jaw position"),
+    ({"crucial": {"point": "tip", "at_cm": [0, 0]}, "lips": "rounded"}, "belong to acoustic targets"),
+])
+def test_bad_acoustic_targets_are_refused_naming_the_key(data, needle):
+    data = {"name": "v", "jaw": {"forces_n": {}}, **data}
+    with pytest.raises(ArticError, match=None) as err:
+        parse_target(data)
+    assert needle in str(err.value), str(err.value)
+
+
+def _linear_net():
+    """A pair net whose formants vary linearly with the two forces (a known inverse)."""
+    lv = np.array([0.0, 1.0, 2.0, 4.0])
+    a, b = np.meshgrid(lv, lv, indexing="ij")
+    f = np.stack([400 + 20 * a + 5 * b, 1500 + 10 * a + 60 * b, 2500 + 0 * a, 3500 + 0 * a], axis=-1)
+    x = np.zeros((4, 4, 3, 3))
+    x[..., 0, 0], x[..., 0, 1] = -0.7 + 0.05 * a, -0.6 + 0.05 * b
+    x[..., 1, 0], x[..., 1, 1] = -4.3, 0.8
+    net = Net(muscles=("A", "B"), levels=(lv, lv), x=x, converged=np.ones((4, 4), bool), drift_cm=np.zeros((4, 4)))
+    jm = JawMaps(forces={}, rest=x[0, 0], single={}, pair={"A+B": net})
+    return jm, {"pair/A+B": f}
+
+
+def test_formants_inside_a_net_give_the_forces_that_make_them():
+    jm, formants = _linear_net()
+    fa, fb = 1.7, 2.3
+    goal = (400 + 20 * fa + 5 * fb, 1500 + 10 * fa + 60 * fb)
+    cands = solve_acoustic_on(jm, _acoustic(goal, tol=1.0), formants)
+    best = cands[0]
+    assert best.forces == pytest.approx({"A": fa, "B": fb}, abs=0.02)
+    assert within(_acoustic(goal, tol=0.2), best.detail["formants_hz"])
+    with pytest.raises(UnreachableTarget, match="nearest mapped formants are F1 .* Hz"):
+        solve_acoustic_on(jm, _acoustic((300, 2600), tol=5.0), formants)
+
+
+@pytest.fixture(scope="module")
+def small_maps(tmp_path_factory, mesh_file):
+    """Rest-jaw maps: three vectors and one net (the default speaker)."""
+    tmp = tmp_path_factory.mktemp("amaps")
+    d = yaml.safe_load((ROOT / "configs" / "default.yaml").read_text())
+    d["epmap"] = dict(d.get("epmap", {}), jaw_positions={"rest": {}}, typical_jaw="rest", muscles=["GGp", "HG", "SG"],
+                      levels_n=[0.0, 1.0, 2.5, 4.0], pair_levels_n=[1.0, 2.5, 4.0], pairs_tip=[["GGp", "HG"]],
+                      pairs_dorsum=[], groups=[], net_jaw_positions=["rest"])
+    cfg = tmp / "cfg.yaml"
+    cfg.write_text(yaml.safe_dump(d, sort_keys=False))
+    build_ep_maps(mesh_file, cfg, tmp / "maps.h5", jobs=2, cache=tmp / "cache")
+    return tmp, cfg
+
+
+def test_a_simulated_vowel_is_found_again_and_refined_within_its_tolerance(small_maps, mesh_file):
+    tmp, cfg = small_maps
+    voicer = simulator(mesh_file, cfg, voiced=True)
+    made = voicer.voice({}, {"GGp": 2.0, "HG": 1.5}, (3.0, 1.0), 0.0)  # the config's lips, port closed
+    target = _acoustic(made["formants_hz"][:2], tol=2.0, name="found")
+    ctx = add_formants(load_context(tmp / "maps.h5", None, mesh_file), tmp / "maps.h5", mesh_file, cfg)
+    doc, path, _ = solve_target(target, ctx, tmp / "found.yaml", voicer, refine=True, budget=6, config=cfg,
+                                mesh_sha256=voicer.mesh_sha256)
+    assert doc["refined"]["converged"] and doc["refined"]["within_tolerance"]
+    assert all(abs(e) <= 2.0 for e in doc["refined"]["errors_pct"][:2])
+    af = doc["refined"]["area_function"]
+    assert len(af["length_cm"]) == len(af["area_cm2"]) and 14.0 < sum(af["length_cm"]) < 22.0
+    assert doc["lips"] == {"area_cm2": 3.0, "length_cm": 1.0}
+    # rounded lips lengthen and narrow the lip tube: every EP's F2 falls
+    neutral, rounded = ctx.formants("rest", 3.0, 1.0, 0.0), ctx.formants("rest", 0.6, 1.5, 0.0)
+    assert (rounded["single/GGp"][:, 1] < neutral["single/GGp"][:, 1] - 50).all()
+
+
+def test_unreachable_formants_exit_3_with_the_nearest_and_write_it(small_maps, mesh_file, tmp_path):
+    tmp, cfg = small_maps
+    target = tmp_path / "far.yaml"
+    target.write_text("name: far\njaw: {forces_n: {}}\nacoustic: {formants_hz: [300, 2600], tolerance_pct: 5}\n")
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    res = subprocess.run([sys.executable, "-m", "artic_cli.cli.main", "solve-target", str(target), "--maps",
+                          str(tmp / "maps.h5"), "--mesh", str(mesh_file), "--config", str(cfg), "--acoustic-maps",
+                          str(tmp_path / "none.h5"), "--out", str(tmp_path / "far_sol.yaml")],
+                         capture_output=True, text=True, cwd=ROOT, env=env, timeout=300)
+    assert res.returncode == 3 and "Traceback" not in res.stderr, res.stderr
+    lines = [ln for ln in res.stderr.splitlines() if ln.strip()]
+    assert len(lines) == 1 and "nearest mapped formants" in lines[0]
+    sol = yaml.safe_load((tmp_path / "far_sol.yaml").read_text())
+    assert "unreachable" in sol and sol["nearest"]["forces_n"] and len(sol["nearest"]["predicted_formants_hz"]) == 4
