@@ -36,6 +36,7 @@ class Pipeline(Strict):
     tract_schedules: list[str] = []  # articulator schedules whose simulations get a vocal tract and acoustics
     experiments: list[str] = []
     targets: list[str] = []
+    vowels: list[str] = []  # configs/targets/vowels/*.yaml
 
 
 def load_pipeline(path: Path | str) -> Pipeline:
@@ -55,6 +56,9 @@ def load_pipeline(path: Path | str) -> Pipeline:
     for name in p.targets:
         if not (ROOT / "configs" / "targets" / f"{name}.yaml").is_file():
             raise ArticError(f"{path}: target '{name}' has no configs/targets/{name}.yaml")
+    for name in p.vowels:
+        if not (ROOT / "configs" / "targets" / "vowels" / f"{name}.yaml").is_file():
+            raise ArticError(f"{path}: vowel '{name}' has no configs/targets/vowels/{name}.yaml")
     return p
 
 

@@ -9,7 +9,9 @@ glottis end reflects with ``glottal_reflection`` (nearly closed).  The lips refl
 radiation load as the frequency-domain model (a piston in a baffle, parallel R-L), as a first-order filter
 (bilinear transform of (Z - Zc) / (Z + Zc), Zc = rho c / A_lips): -1 at low frequencies, with the end
 correction that lowers the formants of a wide mouth.  Each section passes ``1 - section_loss`` of a wave
-(wall and boundary-layer losses lumped).  The radiated sound
+(wall and boundary-layer losses lumped).  A closed side branch (the piriform fossae, as the transfer
+function has them) joins at a three-tube junction: one pressure 2 sum(A p_in) / sum(A), each tube's
+outgoing wave that pressure less its incoming one.  The radiated sound
 is the time derivative of the lips' volume velocity, brought to the audio rate by a polyphase filter.
 """
 
@@ -24,7 +26,8 @@ MIN_AREA_CM2 = 1e-4
 
 
 @njit(cache=True)
-def _line(frame_areas, frame_index, source, glottal_reflection, rho, c, fs, loss):  # pragma: no cover - compiled
+def _line(frame_areas, frame_index, source, glottal_reflection, rho, c, fs, loss, branch_at,
+          branch_areas):  # pragma: no cover - compiled
     n_samples = source.shape[0]
     n = frame_areas.shape[1]
     fwd = np.zeros(n)
@@ -32,6 +35,11 @@ def _line(frame_areas, frame_index, source, glottal_reflection, rho, c, fs, loss
     new_f = np.zeros(n)
     new_b = np.zeros(n)
     area = np.zeros(n)
+    m = branch_areas.shape[0]
+    bf = np.zeros(m)  # the side branch: waves away from its junction ...
+    bb = np.zeros(m)  # ... and toward it
+    new_bf = np.zeros(m)
+    new_bb = np.zeros(m)
     out = np.zeros(n_samples)
     last_u = 0.0
     keep = 1.0 - loss
@@ -49,9 +57,25 @@ def _line(frame_areas, frame_index, source, glottal_reflection, rho, c, fs, loss
             area[j] = a if a > 1e-4 else 1e-4
         new_f[0] = glottal_reflection * bwd[0] + source[s] / area[0]
         for j in range(n - 1):
+            if j == branch_at:  # three tubes meet: one junction pressure, each tube's outgoing wave from it
+                a3 = branch_areas[0]
+                pj = 2.0 * (area[j] * fwd[j] + area[j + 1] * bwd[j + 1] + a3 * bb[0]) / (area[j] + area[j + 1] + a3)
+                new_f[j + 1] = pj - bwd[j + 1]
+                new_b[j] = pj - fwd[j]
+                new_bf[0] = pj - bb[0]
+                continue
             r = (area[j] - area[j + 1]) / (area[j] + area[j + 1])
             new_f[j + 1] = (1.0 + r) * fwd[j] - r * bwd[j + 1]
             new_b[j] = r * fwd[j] + (1.0 - r) * bwd[j + 1]
+        if m > 0:
+            for k in range(m - 1):
+                r = (branch_areas[k] - branch_areas[k + 1]) / (branch_areas[k] + branch_areas[k + 1])
+                new_bf[k + 1] = (1.0 + r) * bf[k] - r * bb[k + 1]
+                new_bb[k] = r * bf[k] + (1.0 - r) * bb[k + 1]
+            new_bb[m - 1] = bf[m - 1]  # its far end is closed
+            for k in range(m):
+                bf[k] = keep * new_bf[k]
+                bb[k] = keep * new_bb[k]
         a_l = area[n - 1]
         zc = rho * c / a_l
         r_rad = 128.0 * rho * c / (9.0 * pi * pi * a_l)
@@ -84,14 +108,25 @@ def resample_tube(length_cm: np.ndarray, area_cm2: np.ndarray, n: int) -> np.nda
     return np.asarray(area_cm2, dtype=float)[k]
 
 
+def side_branch(at_cm: float, tube_length_cm: float, n: int, branch_length_cm: np.ndarray,
+                branch_area_cm2: np.ndarray, c_cm_s: float, fs_internal: float) -> tuple[int, np.ndarray]:
+    """Where a closed side branch (the piriform fossae) joins a line of n equal sections over
+    ``tube_length_cm`` (the junction after section k) and its areas at the line's section length."""
+    k = int(round(at_cm / (tube_length_cm / n))) - 1
+    m = sections_for(float(np.sum(branch_length_cm)), c_cm_s, fs_internal)
+    return max(0, min(k, n - 2)), np.maximum(resample_tube(branch_length_cm, branch_area_cm2, m), MIN_AREA_CM2)
+
+
 def synthesize(frame_areas: np.ndarray, frame_times_s: np.ndarray, source: np.ndarray, fs_internal: float,
                glottal_reflection: float = 0.97, section_loss: float = 5e-4, rho: float = 1.14e-3,
-               c: float = 35000.0) -> np.ndarray:
+               c: float = 35000.0, branch: tuple[int, np.ndarray] | None = None) -> np.ndarray:
     """The radiated sound at ``fs_internal`` for areas (frames x N equal sections) at ``frame_times_s`` and a
-    source (flow derivative per internal sample)."""
+    source (flow derivative per internal sample); ``branch``: a closed side tube, (the section after which it
+    joins, its areas), from :func:`side_branch`."""
     t = np.arange(len(source)) / fs_internal
     index = np.interp(t, frame_times_s, np.arange(len(frame_times_s))) if len(frame_times_s) > 1 else np.zeros(len(t))
     # the source drives flow: integrate its derivative (leaky, so no drift) before it enters the line
     flow = lfilter([1.0 / fs_internal], [1.0, -0.999], source)
+    at, areas = (-1, np.zeros(0)) if branch is None else (int(branch[0]), np.asarray(branch[1], dtype=float))
     return _line(np.ascontiguousarray(frame_areas, dtype=float), index.astype(float), flow * 1e4,
-                 glottal_reflection, rho, c, float(fs_internal), section_loss)
+                 glottal_reflection, rho, c, float(fs_internal), section_loss, at, areas)

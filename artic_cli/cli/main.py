@@ -593,7 +593,8 @@ def _print_acoustic_solution(t, doc: dict, path: Path) -> None:
     out_console.print(f"wrote {path}", highlight=False)
     last = doc.get("refined")
     if last is not None and not last["converged"]:
-        err_console.print(f"target '{t.name}': F1/F2 not within {t.acoustic.tolerance_pct:g} % after "
+        tol = " / ".join(f"{100 * v:g}" for v in t.acoustic.tolerance)
+        err_console.print(f"target '{t.name}': F1/F2 not within {tol} % after "
                           f"{last['simulations']} simulations (errors {', '.join(f'{e:+.1f} %' for e in last['errors_pct'])}, "
                           f"written to {path}); raise --budget or the tolerance", highlight=False)
         raise typer.Exit(3)
@@ -822,8 +823,10 @@ def synthesize_cmd(
     tube: Optional[Path] = typer.Option(None, "--tube", help="Tube (CSV): header length_cm,area_cm2, glottis first."),
     tracts: Optional[Path] = typer.Option(None, "--tracts", help="Vocal-tract file: its frames, areas interpolated "
                                                                  "sample by sample."),
-    duration: Optional[float] = typer.Option(None, "--duration", help="How long, s (default: a tube 1 s, tracts "
-                                                                      "their frames' span)."),
+    solution: Optional[Path] = typer.Option(None, "--solution", help="A solve-target answer of an acoustic target: "
+                                                                     "its simulated area function."),
+    duration: Optional[float] = typer.Option(None, "--duration", help="How long, s (default: a tube or solution 1 s, "
+                                                                      "tracts their frames' span)."),
     f0: float = typer.Option(110.0, "--f0", help="Fundamental frequency, Hz (50-500)."),
     f0_contour: Optional[Path] = typer.Option(None, "--f0-contour", help="F0 over time instead (CSV: "
                                                                           "time_s,f0_hz)."),
@@ -834,16 +837,20 @@ def synthesize_cmd(
     plot: Optional[Path] = typer.Option(None, "--plot", help="Draw the sound's spectrogram (PNG)."),
     config: Optional[Path] = typer.Option(None, "--config", help="Config (its 'acoustics.synthesis' section)."),
 ):
-    """Voice a tube or a vocal-tract file with the LF source through a reflection-type line; write a WAV file."""
-    from ..stages.synthesize import synthesize_tracts, synthesize_tube
+    """Voice a tube, a vocal-tract file or a solved vowel with the LF source through a reflection-type line;
+    write a WAV file."""
+    from ..stages.synthesize import synthesize_solution, synthesize_tracts, synthesize_tube
 
-    if (tube is None) == (tracts is None):
-        raise ArticError("give one of --tube FILE.csv or --tracts FILE.h5")
+    if sum(v is not None for v in (tube, tracts, solution)) != 1:
+        raise ArticError("give one of --tube FILE.csv, --tracts FILE.h5 or --solution FILE.yaml")
     if plot is not None and not plot.parent.is_dir():
         raise ArticError(f"--plot {plot}: the folder {plot.parent} does not exist; create it or give another path")
     if tube is not None:
         a = synthesize_tube(tube, out, 1.0 if duration is None else duration, f0, f0_contour, config,
                             amplitude_contour, aspiration)
+    elif solution is not None:
+        a = synthesize_solution(solution, out, 1.0 if duration is None else duration, f0, f0_contour, config,
+                                amplitude_contour, aspiration)
     else:
         a = synthesize_tracts(tracts, out, f0, f0_contour, config, amplitude_contour, aspiration, duration)
     out_console.print(f"wrote {out}: {len(a.samples) / a.sample_rate_hz:.2f} s at {a.sample_rate_hz} Hz, 16-bit PCM",

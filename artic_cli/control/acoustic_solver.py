@@ -26,7 +26,7 @@ def within(target: TargetSpec, formants_hz) -> bool:
     """F1 and F2 each within the target's tolerance."""
     f = np.asarray(formants_hz, dtype=float)[:2]
     goal = np.asarray(target.acoustic.formants_hz[:2])
-    return bool(np.all(np.isfinite(f)) and np.all(np.abs(f / goal - 1.0) <= target.acoustic.tolerance_pct / 100))
+    return bool(np.all(np.isfinite(f)) and np.all(np.abs(f / goal - 1.0) <= target.acoustic.tolerance))
 
 
 def errors_pct(target: TargetSpec, formants_hz) -> list[float]:
@@ -43,8 +43,7 @@ class AcousticProblem:
         goal = np.asarray(target.acoustic.formants_hz, dtype=float)
         self.goal_hz = goal
         self.goal = hz_to_bark(goal[:2])
-        tol = target.acoustic.tolerance_pct / 100
-        box = hz_to_bark(goal[:2] * (1 + tol)) - self.goal  # the tolerance in Bark, per formant
+        box = hz_to_bark(goal[:2] * (1 + target.acoustic.tolerance)) - self.goal  # the tolerance in Bark
         self.reach = reach * float(np.hypot(*box))  # cells and vectors searched within this Bark distance
 
     def cost(self, forces: dict[str, float], pred: np.ndarray, f_hz: np.ndarray) -> float:

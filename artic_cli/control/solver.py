@@ -54,12 +54,21 @@ class Indecisive(Strict):
     weight: NonNegative = 1.0
 
 
+Pct = Annotated[float, Field(gt=0, le=50, allow_inf_nan=False)]
+
+
 class AcousticGoal(Strict):
     """A vowel's formants: F1 and F2 must come within ``tolerance_pct``; F3 (optional) is approached."""
 
     formants_hz: Annotated[list[FormantHz], Field(min_length=2, max_length=3)]
-    tolerance_pct: Annotated[float, Field(gt=0, le=50, allow_inf_nan=False)] = 10.0
+    tolerance_pct: Pct | Annotated[list[Pct], Field(min_length=2, max_length=2)] = 10.0  # one, or F1's and F2's
     f3_weight: NonNegative = 0.3  # Bark^-2 relative to F1-F2's, in the choice among candidates
+
+    @property
+    def tolerance(self) -> np.ndarray:
+        """(2,) F1's and F2's tolerance as fractions."""
+        t = self.tolerance_pct if isinstance(self.tolerance_pct, list) else [self.tolerance_pct] * 2
+        return np.asarray(t, dtype=float) / 100.0
 
     @field_validator("formants_hz")
     @classmethod

@@ -139,6 +139,11 @@ def solve_acoustic(ctx: Context, target: TargetSpec, voicer=None, verify: bool =
         near = nearest_candidate(jm, target, formants)
         if near is not None:
             err.answer = dict(head, nearest=voiced_cand(near))
+            if (verify or refine) and voicer is not None:  # ... and what it really gives
+                v = voicer.voice(dict(jm.forces), near.forces, lips, port)
+                err.answer["verified"] = _formant_doc(target, v["formants_hz"], {
+                    "forces_n": {k: _num(f) for k, f in near.forces.items()}, "reached_cm": v["reached_cm"],
+                    "area_function": v["area_function"], "simulations": 1})
         raise
     chosen = cands[0]
     doc = dict(head, chosen=voiced_cand(chosen), candidates=[voiced_cand(c) for c in cands[:TOP]],

@@ -13,7 +13,8 @@ from scipy.io import wavfile
 from scipy.signal import resample_poly
 
 from ..acoustics.source import lf_flow_derivative
-from ..acoustics.synthesis import resample_tube, sections_for, synthesize
+from ..acoustics.model import tract_of
+from ..acoustics.synthesis import resample_tube, sections_for, side_branch, synthesize
 from ..acoustics.tube import Tube, read_tube_csv
 from ..config import Config, load_config
 from ..errors import ArticError
@@ -81,8 +82,15 @@ def compute_frames(lengths_cm: np.ndarray, areas_cm2: np.ndarray, times_s: np.nd
     areas = frame_areas(lengths_cm, areas_cm2, n)
     t = np.arange(int(round(duration_s * fs))) / fs
     src = source_for(t, fs, sy, f0_hz, contour, amplitude, aspiration)
+    branch = None
+    pf = ac.piriform_fossa
+    mean_length = float(np.mean(lengths_cm.sum(axis=1)))
+    if pf.enabled and mean_length > pf.from_glottis_cm:  # the transfer function's fossa (acoustics/model.py)
+        fossa = tract_of(Tube(np.array([mean_length]), np.array([1.0])), ac, velum_area_cm2=0.0).branches[0].tube
+        branch = side_branch(pf.from_glottis_cm, mean_length, n, fossa.length_cm, fossa.area_cm2,
+                             ac.sound_speed_cm_s, fs)
     y = synthesize(areas, np.asarray(times_s, float) - float(times_s[0]), src, fs, sy.glottal_reflection,
-                   sy.section_loss, ac.air_density_g_cm3, ac.sound_speed_cm_s)
+                   sy.section_loss, ac.air_density_g_cm3, ac.sound_speed_cm_s, branch)
     y = resample_poly(y, 1, 2)
     peak = float(np.max(np.abs(y))) if len(y) else 0.0
     return Audio(0.9 * y / peak if peak > 0 else y, sy.sample_rate_hz)
@@ -171,6 +179,43 @@ def synthesize_tube(tube: Path | str, out: Path | str, duration_s: float, f0_hz:
     cfg = load_config(config)
     t = read_tube_csv(tube)
     audio = compute(t, cfg, duration_s, f0_hz, contour, amp, aspiration)
+    write(out, audio)
+    return audio
+
+
+def solution_tube(path: Path | str) -> Tube:
+    """The simulated area function a solve-target answer records (refined, else verified)."""
+    from ..config import read_yaml
+    from ..validation import check_number
+
+    doc = read_yaml(path, "solution file")
+    if not isinstance(doc, dict) or not ("chosen" in doc or "unreachable" in doc):
+        raise ArticError(f"{path} is not a solve-target answer; run 'artic solve-target' first")
+    for key in ("refined", "verified"):
+        af = (doc.get(key) or {}).get("area_function")
+        if af:
+            try:
+                lengths = np.asarray(af["length_cm"], dtype=float)
+                areas = np.asarray(af["area_cm2"], dtype=float)
+            except (KeyError, TypeError, ValueError):
+                break
+            if lengths.shape != areas.shape or lengths.ndim != 1 or not len(lengths):
+                break
+            for k, (l, a) in enumerate(zip(lengths, areas)):
+                check_number(f"{path}: {key}.area_function.length_cm[{k}]", float(l), gt=0, le=5, unit="cm")
+                check_number(f"{path}: {key}.area_function.area_cm2[{k}]", float(a), ge=0, le=50, unit="cm^2")
+            return Tube(lengths, areas)
+    raise ArticError(f"{path} records no simulated area function; solve the target with --verify or --refine "
+                     "(an acoustic target)")
+
+
+def synthesize_solution(solution: Path | str, out: Path | str, duration_s: float, f0_hz: float | None = 110.0,
+                        f0_contour: Path | str | None = None, config: Path | str | None = None,
+                        amplitude_contour: Path | str | None = None, aspiration: float = 0.0) -> Audio:
+    """The sound of a solved vowel: its simulated area function held for ``duration_s``."""
+    out, contour, amp = _voice_inputs(out, duration_s, f0_hz, f0_contour, amplitude_contour, aspiration)
+    cfg = load_config(config)
+    audio = compute(solution_tube(solution), cfg, duration_s, f0_hz, contour, amp, aspiration)
     write(out, audio)
     return audio
 

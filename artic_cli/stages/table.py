@@ -118,6 +118,15 @@ STAGES: tuple[StageEntry, ...] = (
                figures=(Figure("{report}/fig12_{name}.png", "plot solution {output} --target {target} --maps {maps} "
                                "--dynamic {dynamic}", "--out {figure}", "artic_cli.plots.solution",
                                (MAPS, DYN, "configs/targets/{name}.yaml")),)),
+    StageEntry("vowels", "artic_cli.stages.solve", "{out}/vowels/{name}.yaml",
+               "solve-target configs/targets/vowels/{name}.yaml --maps {maps} --mesh {mesh} --config {config} "
+               "--acoustic-maps {out}/acoustic_maps.h5 --refine --out {output}",
+               inputs=(MAPS, MESH, "{out}/acoustic_maps.h5", "configs/targets/vowels/{name}.yaml"), items="vowels",
+               ok_status=(0, 3)),
+    StageEntry("vowels-audio", "artic_cli.stages.synthesize", "{out}/vowels/{name}.wav",
+               "synthesize --solution {out}/vowels/{name}.yaml --duration 0.6 --f0-contour "
+               "configs/voice/f0_fall_125_100.csv --config {config} --out {output}",
+               inputs=("{out}/vowels/{name}.yaml", "configs/voice/f0_fall_125_100.csv"), items="vowels"),
 )
 
 
@@ -137,6 +146,7 @@ REPORT: tuple[ReportSection, ...] = (
                   ("musclefunction", "experiments")),
     ReportSection("maps", "EP maps, dynamic maps and the target solver (sections IV.B and V)",
                   ("epmaps", "dynamic", "solve")),
+    ReportSection("vowels", "Vowels from formant targets (beyond the paper)", ("vowels", "vowels-audio")),
 )
 REPORT_MODULE = "artic_cli.stages.report"
 REPORT_OUTPUT = "{report}/paper.md"
