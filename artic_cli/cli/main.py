@@ -687,6 +687,14 @@ def plot_solution_cmd(
     if not isinstance(doc, dict) or not ("chosen" in doc or "unreachable" in doc):
         raise ArticError(f"{solution} is not a solve-target result; run 'artic solve-target' first")
     t = load_target(target)
+    if t.acoustic is not None:  # a vowel: its formants and simulated area function, no maps needed
+        from ..plots.solution import plot_acoustic_solution
+
+        if "acoustic" not in doc:
+            raise ArticError(f"{solution} answers a spatial target, {target} is an acoustic one; give the pair that "
+                             "belong together")
+        out_console.print(f"wrote {plot_acoustic_solution(doc, t, out)}", highlight=False)
+        return
     ctx = load_context(maps, dynamic)
     jm, _, _, _ = jaw_maps(ctx, t)
     path = plot_solution(doc, t, jm, out)

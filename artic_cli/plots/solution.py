@@ -66,3 +66,50 @@ def _plot_unreachable(doc: dict, target, jm, path: Path | str) -> Path:
     ax.legend(fontsize=7)
     ax.set_title(doc["unreachable"][:110] + ("..." if len(doc["unreachable"]) > 110 else ""), fontsize=7)
     return save_figure(fig, path)
+
+
+def plot_acoustic_solution(doc: dict, target, path: Path | str) -> Path:
+    """A vowel's answer: the F1-F2 plane (target and its tolerance, the candidates, the simulated result)
+    beside the simulated area function."""
+    import numpy as np
+
+    fig, (ax, af_ax) = plt.subplots(1, 2, figsize=(12, 5))
+    goal = target.acoustic.formants_hz
+    tol = target.acoustic.tolerance
+    ax.add_patch(plt.Rectangle((goal[1] * (1 - tol[1]), goal[0] * (1 - tol[0])), 2 * goal[1] * tol[1],
+                               2 * goal[0] * tol[0], fc="#fde3c8", ec="#e67e22", label="target and tolerance"))
+    ax.plot(goal[1], goal[0], "*", ms=14, color="#e67e22")
+    cands = doc.get("candidates") or ([doc["nearest"]] if "nearest" in doc else [])
+    for k, c in enumerate(cands, start=1):
+        f = c["predicted_formants_hz"]
+        ax.plot(f[1], f[0], "o", ms=11, mfc="none", mec="0.5", label="candidates (maps)" if k == 1 else None)
+        ax.annotate(str(k), (f[1], f[0]), ha="center", va="center", fontsize=7, color="0.3")
+    res = None
+    for key, style in (("verified", ("s", "#2c7fb8")), ("refined", ("D", "#238b45"))):
+        if key in doc:
+            res = doc[key]
+            f = res["formants_hz"]
+            ax.plot(f[1], f[0], style[0], ms=9, color=style[1], label=f"{key} by simulation")
+    ax.set_xlabel("F2 (Hz)")
+    ax.set_ylabel("F1 (Hz)")
+    ax.invert_xaxis()
+    ax.invert_yaxis()  # the phoneticians' vowel chart: front left, high up
+    status = "out of reach: nearest" if "unreachable" in doc else "reached" if (res or {}).get("within_tolerance") \
+        else "not within tolerance"
+    ax.set_title(f"/{doc['target']}/: F1 {goal[0]:g}, F2 {goal[1]:g} Hz ({status})")
+    ax.legend(fontsize=8, loc="lower left")
+    if res is not None and res.get("area_function"):
+        lengths = np.asarray(res["area_function"]["length_cm"])
+        areas = np.asarray(res["area_function"]["area_cm2"])
+        edges = np.concatenate([[0.0], np.cumsum(lengths)])
+        af_ax.stairs(areas, edges, fill=True, color="#9ecae1", ec="#3182bd")
+        af_ax.set_xlabel("distance from the glottis (cm)")
+        af_ax.set_ylabel("area (cm^2)")
+        lips = doc.get("lips", {})
+        af_ax.set_title(f"simulated area function (lips {lips.get('area_cm2', float('nan')):g} cm^2, "
+                        f"{lips.get('length_cm', float('nan')):g} cm)")
+    else:
+        af_ax.text(0.5, 0.5, "no simulation (solve with --verify or --refine)", ha="center", va="center",
+                   transform=af_ax.transAxes)
+        af_ax.set_axis_off()
+    return save_figure(fig, path)

@@ -355,6 +355,7 @@ def vowel_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row], l
              "F1 within 10 % and F2 within 7 %.  An unreachable vowel shows its nearest force set, simulated.", "",
              "| vowel | target F1 / F2 (Hz) | ours F1 / F2 (Hz) | errors | forces (N) | lips (cm^2, cm) | sound |",
              "|---|---|---|---|---|---|---|"]
+    pictures: list[str] = []
     for path in sorted((data / "vowels").glob("*.yaml")):
         doc = read_yaml(path, "vowel solution")
         res = doc.get("refined") or doc.get("verified") or {}
@@ -365,6 +366,7 @@ def vowel_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row], l
         wav = path.with_suffix(".wav")
         sound = f"[{wav.name}]({os.path.relpath(wav, out_dir)})" if wav.is_file() else ""
         lips = doc.get("lips", {})
+        pictures.append(f"![/{doc['target']}/: formants and area function](vowel_{path.stem}.png)")
         lines.append(f"| /{doc['target']}/ | {goal[0]:.0f} / {goal[1]:.0f} | {f[0]:.0f} / {f[1]:.0f} | "
                      f"{err[0]:+.1f} % / {err[1]:+.1f} % | "
                      f"{', '.join(f'{k} {v:g}' for k, v in forces.items()) or 'none'} | "
@@ -375,7 +377,7 @@ def vowel_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row], l
         rows.append(Row(f"/{doc['target']}/: F1 / F2", f"{goal[0]:.0f} / {goal[1]:.0f} Hz",
                         f"{f[0]:.0f} / {f[1]:.0f} Hz ({err[0]:+.1f} %, {err[1]:+.1f} %; {how})",
                         _verdict(ok, "F1 within 10 %, F2 within 7 %")))
-    return rows, lines + [""]
+    return rows, lines + [""] + pictures + [""]
 
 
 SECTIONS = {"tissue": tissue_section, "articulator": articulator_section, "tract": tract_section, "function": function_rows,

@@ -122,7 +122,10 @@ STAGES: tuple[StageEntry, ...] = (
                "solve-target configs/targets/vowels/{name}.yaml --maps {maps} --mesh {mesh} --config {config} "
                "--acoustic-maps {out}/acoustic_maps.h5 --refine --out {output}",
                inputs=(MAPS, MESH, "{out}/acoustic_maps.h5", "configs/targets/vowels/{name}.yaml"), items="vowels",
-               ok_status=(0, 3)),
+               ok_status=(0, 3),
+               figures=(Figure("{report}/vowel_{name}.png", "plot solution {output} --target "
+                               "configs/targets/vowels/{name}.yaml", "--out {figure}", "artic_cli.plots.solution",
+                               ("configs/targets/vowels/{name}.yaml",)),)),
     StageEntry("vowels-audio", "artic_cli.stages.synthesize", "{out}/vowels/{name}.wav",
                "synthesize --solution {out}/vowels/{name}.yaml --duration 0.6 --f0-contour "
                "configs/voice/f0_fall_125_100.csv --config {config} --out {output}",

@@ -151,3 +151,22 @@ def test_a_solution_without_a_usable_area_function_is_refused(tmp_path, body, ne
     sol.write_text(body)
     res = CliRunner().invoke(app, ["synthesize", "--solution", str(sol), "--out", str(tmp_path / "v.wav")])
     assert res.exit_code == 2 and needle in res.output and not (tmp_path / "v.wav").exists(), res.output
+
+
+def test_a_vowel_answer_is_drawn_without_the_maps(small_maps, tmp_path):
+    from typer.testing import CliRunner
+
+    from artic_cli.cli.main import app
+
+    tmp, _ = small_maps
+    sol = tmp / "found.yaml"
+    if not sol.is_file():
+        pytest.skip("needs the refined solution of test_a_simulated_vowel_is_found_again...")
+    doc = yaml.safe_load(sol.read_text())
+    target = tmp_path / "found_target.yaml"
+    target.write_text(yaml.safe_dump({"name": "found", "jaw": {"forces_n": {}},
+                                      "acoustic": {"formants_hz": doc["acoustic"]["formants_hz"]}}))
+    res = CliRunner().invoke(app, ["plot", "solution", str(sol), "--target", str(target), "--out",
+                                   str(tmp_path / "v.png"), "--maps", str(tmp_path / "none.h5")])
+    assert res.exit_code == 0, res.output
+    assert (tmp_path / "v.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
