@@ -2,10 +2,6 @@
 
 from __future__ import annotations
 
-import os
-import subprocess
-import sys
-
 import numpy as np
 import pytest
 import yaml
@@ -105,13 +101,15 @@ def test_unreachable_formants_exit_3_with_the_nearest_and_write_it(small_maps, m
     tmp, cfg = small_maps
     target = tmp_path / "far.yaml"
     target.write_text("name: far\njaw: {forces_n: {}}\nacoustic: {formants_hz: [300, 2600], tolerance_pct: 5}\n")
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
-    res = subprocess.run([sys.executable, "-m", "artic_cli.cli.main", "solve-target", str(target), "--maps",
-                          str(tmp / "maps.h5"), "--mesh", str(mesh_file), "--config", str(cfg), "--acoustic-maps",
-                          str(tmp_path / "none.h5"), "--out", str(tmp_path / "far_sol.yaml")],
-                         capture_output=True, text=True, cwd=ROOT, env=env, timeout=300)
-    assert res.returncode == 3 and "Traceback" not in res.stderr, res.stderr
-    lines = [ln for ln in res.stderr.splitlines() if ln.strip()]
+    from typer.testing import CliRunner
+
+    from artic_cli.cli.main import app
+
+    res = CliRunner().invoke(app, ["solve-target", str(target), "--maps", str(tmp / "maps.h5"), "--mesh",
+                                   str(mesh_file), "--config", str(cfg), "--acoustic-maps", str(tmp_path / "none.h5"),
+                                   "--out", str(tmp_path / "far_sol.yaml")])
+    assert res.exit_code == 3 and "Traceback" not in res.output, res.output
+    lines = [ln for ln in res.output.splitlines() if ln.strip()]
     assert len(lines) == 1 and "nearest mapped formants" in lines[0]
     sol = yaml.safe_load((tmp_path / "far_sol.yaml").read_text())
     assert "unreachable" in sol and sol["nearest"]["forces_n"] and len(sol["nearest"]["predicted_formants_hz"]) == 4
