@@ -48,14 +48,22 @@ schedules = st.one_of(
     anything)
 names = st.one_of(st.sampled_from(["ok", "../../escaped", "/tmp/abs", ".hidden", "a/b", "..", "x" * 150, "é", ""]),
                   st.text(max_size=12))
+jaws = st.one_of(st.fixed_dictionaries({"forces_n": st.dictionaries(st.sampled_from(["JO", "JC", "XX"]), numbers,
+                                                                     max_size=2)}),
+                 st.fixed_dictionaries({"opening_cm": numbers}), anything)
+lips = st.one_of(st.sampled_from(["rounded", "compressed", "neutral", "pursed", ""]),
+                 st.fixed_dictionaries({"area_cm2": _maybe(numbers), "length_cm": _maybe(numbers)}), anything)
 targets = st.one_of(
     st.fixed_dictionaries(
         {"crucial": st.fixed_dictionaries({"point": _maybe(st.sampled_from(["tip", "dorsum", "lip"])),
                                            "at_cm": st.one_of(st.lists(numbers, min_size=2, max_size=2), anything)},
                                           optional={"tolerance_cm": _maybe(numbers)})},
-        optional={"name": names, "jaw": st.one_of(st.fixed_dictionaries({"forces_n": st.dictionaries(
-            st.sampled_from(["JO", "JC", "XX"]), numbers, max_size=2)}), st.fixed_dictionaries({"opening_cm": numbers}),
-            anything), "force_weight": _maybe(numbers)}),
+        optional={"name": names, "jaw": jaws, "force_weight": _maybe(numbers)}),
+    st.fixed_dictionaries(  # a vowel: formants, lips, port
+        {"acoustic": st.fixed_dictionaries(
+            {"formants_hz": st.one_of(st.lists(_maybe(numbers), min_size=1, max_size=4), anything)},
+            optional={"tolerance_pct": st.one_of(numbers, st.lists(numbers, max_size=3), anything)})},
+        optional={"name": names, "jaw": jaws, "lips": lips, "velum_port_cm2": _maybe(numbers)}),
     anything)
 
 
