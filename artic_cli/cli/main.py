@@ -585,7 +585,8 @@ def _print_acoustic_solution(t, doc: dict, path: Path) -> None:
     for key, label in (("verified", "verified by simulation"), ("refined", "refined")):
         if key in doc:
             r = doc[key]
-            head = (", ".join(f"{k} {v:g} N" for k, v in r["forces_n"].items()) + "; ") if "forces_n" in r else ""
+            head = ((", ".join(f"{k} {v:g} N" for k, v in r["forces_n"].items()) or "no tongue force") + "; ") \
+                if "forces_n" in r else ""
             out_console.print(f"{label}: {head}{fmt(r['formants_hz'])} Hz, errors "
                               f"{', '.join(f'{e:+.1f} %' for e in r['errors_pct'])}"
                               + (f" after {r['simulations']} simulations" if key == "refined" else ""),

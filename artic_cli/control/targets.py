@@ -112,7 +112,7 @@ def solve_acoustic(ctx: Context, target: TargetSpec, voicer=None, verify: bool =
     """An acoustic target: candidates from the EPs' formants, checked (``verify``) or corrected (``refine``)
     by ``voicer.voice(jaw_forces, forces, lips, port) -> dict(formants_hz, reached_cm, area_function)``."""
     from .acoustic_solver import nearest_candidate, solve_acoustic_on, within
-    from .verify import _free, _map_jacobian, broyden
+    from .verify import _free, _map_jacobian, broyden, top_force
     from ..units import hz_to_bark
 
     if ctx.formants is None:
@@ -179,7 +179,8 @@ def solve_acoustic(ctx: Context, target: TargetSpec, voicer=None, verify: bool =
         free = _free(cand)
         r = broyden(measure, _map_jacobian(jm, cand, free, feature), cand.forces, free, goal,
                     lambda e, v: within(target, v["formants_hz"]), left,
-                    first=(measure(cand.forces) if k > 0 else (hz_to_bark(np.asarray(first["formants_hz"][:2])), first)))
+                    first=(measure(cand.forces) if k > 0 else (hz_to_bark(np.asarray(first["formants_hz"][:2])), first)),
+                    upper=top_force(jm))
         left -= r.simulations + (1 if k > 0 else 0)
         tried.append(f"{cand.family} {cand.name}")
         if best is None or r.error < best[0].error:

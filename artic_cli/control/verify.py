@@ -107,10 +107,17 @@ class Correction:
     history: list[dict] = field(default_factory=list)
 
 
+def top_force(jm: JawMaps) -> float:
+    """The largest force the maps of a jaw position hold (a refinement stays within the mapped range)."""
+    return float(max(float(np.max(lv)) for fam in (jm.single, jm.pair, jm.group) for net in fam.values()
+                     for lv in net.levels))
+
+
 def broyden(measure, jac: np.ndarray, forces: dict[str, float], free: list[str], goal: np.ndarray, done,
-            budget: int, first=None) -> Correction:
-    """Quasi-Newton on the free forces until ``done(error, extra)``: ``measure(forces) -> (feature, extra)``
-    simulates; the first Jacobian is given (from the maps), later ones come from Broyden's update."""
+            budget: int, first=None, upper: float = np.inf) -> Correction:
+    """Quasi-Newton on the free forces (kept within 0..``upper`` N) until ``done(error, extra)``:
+    ``measure(forces) -> (feature, extra)`` simulates; the first Jacobian is given (from the maps), later
+    ones come from Broyden's update."""
     forces = dict(forces)
     feat, extra = measure(forces) if first is None else first
     sims = 1 if first is None else 0
@@ -121,7 +128,7 @@ def broyden(measure, jac: np.ndarray, forces: dict[str, float], free: list[str],
         step, *_ = np.linalg.lstsq(jac, err, rcond=None)
         step = np.clip(step, -MAX_STEP_N, MAX_STEP_N)
         f = np.array([forces.get(m, 0.0) for m in free])
-        new = np.maximum(f + step, 0.0)
+        new = np.clip(f + step, 0.0, upper)
         step = new - f
         if np.abs(step).max() < 1e-6:
             break
@@ -150,6 +157,6 @@ def refine(sim: Simulator, jm: JawMaps, jaw_forces: dict[str, float], candidate:
         return x[c, :2], x
 
     r = broyden(measure, jac, candidate.forces, free, goal, lambda e, _: e <= tolerance, budget,
-                None if first is None else (first[c, :2], first))
+                None if first is None else (first[c, :2], first), upper=top_force(jm))
     history = [{"forces_n": h["forces_n"], "error_cm": h["error"]} for h in r.history]
     return Refinement(forces=r.forces, reached=r.extra, error=r.error, simulations=r.simulations, history=history)
