@@ -352,9 +352,7 @@ def vowel_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row], l
     out_dir = Path("reports") if out_dir is None else out_dir
     rows: list[Row] = []
     lines = ["Each vowel is a formant target (male Japanese averages) solved on the EP maps with `--refine`: "
-             "F1 within 10 % and F2 within 7 %.  An unreachable vowel shows its nearest force set, simulated.", "",
-             "| vowel | target F1 / F2 (Hz) | ours F1 / F2 (Hz) | errors | forces (N) | lips (cm^2, cm) | sound |",
-             "|---|---|---|---|---|---|---|"]
+             "F1 within 10 % and F2 within 7 %.  An unreachable vowel shows its nearest force set, simulated.", ""]
     pictures: list[str] = []
     for path in sorted((data / "vowels").glob("*.yaml")):
         doc = read_yaml(path, "vowel solution")
@@ -367,10 +365,11 @@ def vowel_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row], l
         sound = f"[{wav.name}]({os.path.relpath(wav, out_dir)})" if wav.is_file() else ""
         lips = doc.get("lips", {})
         pictures.append(f"![/{doc['target']}/: formants and area function](vowel_{path.stem}.png)")
-        lines.append(f"| /{doc['target']}/ | {goal[0]:.0f} / {goal[1]:.0f} | {f[0]:.0f} / {f[1]:.0f} | "
-                     f"{err[0]:+.1f} % / {err[1]:+.1f} % | "
-                     f"{', '.join(f'{k} {v:g}' for k, v in forces.items()) or 'none'} | "
-                     f"{lips.get('area_cm2', np.nan):g}, {lips.get('length_cm', np.nan):g} | {sound} |")
+        lines.append(f"* /{doc['target']}/: target F1 / F2 {goal[0]:.0f} / {goal[1]:.0f} Hz, ours {f[0]:.0f} / "
+                     f"{f[1]:.0f} Hz ({err[0]:+.1f} %, {err[1]:+.1f} %); forces "
+                     f"{', '.join(f'{k} {v:g} N' for k, v in forces.items()) or 'none'}; lips "
+                     f"{lips.get('area_cm2', np.nan):g} cm^2, {lips.get('length_cm', np.nan):g} cm" +
+                     (f"; listen: {sound}" if sound else ""))
         ok = bool(res.get("within_tolerance")) and "unreachable" not in doc
         how = "unreachable by the maps: nearest force set simulated" if "unreachable" in doc else (
             "refined by simulation" if "refined" in doc else "verified by simulation")
