@@ -16,7 +16,7 @@ import yaml
 from pydantic import Field, ValidationError, field_validator
 
 from .errors import ArticError
-from .validation import DEFAULT_MAX_FORCE_N, Finite, Point2, Point3, Strict, describe, parse
+from .validation import DEFAULT_MAX_FORCE_N, Finite, Point2, Point3, Strict, describe, increasing, parse
 
 DEFAULT_CONFIG = Path(__file__).resolve().parent.parent / "configs" / "default.yaml"
 
@@ -183,9 +183,7 @@ class EPMapSpec(Strict):
     @field_validator("levels_n", "pair_levels_n", "group_levels_n")
     @classmethod
     def _increasing(cls, v):
-        if any(b <= a for a, b in zip(v, v[1:])):
-            raise ValueError("force levels must increase")
-        return v
+        return increasing(v, "force levels must increase")
 
 
 class MuscleFunctionSpec(Strict):

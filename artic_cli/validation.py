@@ -42,6 +42,13 @@ def _safe_name(value: str) -> str:
     return value
 
 
+def increasing(values: list, message: str) -> list:
+    """``values`` if each is larger than the one before, else a ValueError with ``message`` (a validator's)."""
+    if any(b <= a for a, b in zip(values, values[1:])):
+        raise ValueError(message)
+    return values
+
+
 SAFE_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.\-]{0,99}")
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]

@@ -17,7 +17,8 @@ import numpy as np
 from ..errors import UnreachableTarget
 from ..units import hz_to_bark
 from .epmap import JawMaps
-from .solver import Candidate, TargetSpec, _bilinear, _polyline_nearest, _settled_run, indecisive_cost, invert_cells
+from .solver import (Candidate, TargetSpec, _bilinear, _polyline_nearest, _settled_run, cell_corners, good_cells,
+                     indecisive_cost, invert_cells)
 
 FormantNets = dict  # "single/SG" | "pair/A+B" | "group/I+A+B" -> (*grid, K) formants of the net's EPs, Hz
 
@@ -103,13 +104,8 @@ class AcousticProblem:
     def _cells(x: np.ndarray, conv: np.ndarray, f: np.ndarray):
         """Cells whose four corners settled and have F1 and F2: indices, control-point corners (C, 4, 4) and
         formant corners (C, 4, K)."""
-        na, nb = conv.shape
-        ii, jj = (g.ravel() for g in np.meshgrid(np.arange(na - 1), np.arange(nb - 1), indexing="ij"))
-        good = conv & np.isfinite(f[..., :2]).all(axis=-1)
-        ok = good[ii, jj] & good[ii + 1, jj] & good[ii, jj + 1] & good[ii + 1, jj + 1]
-        ii, jj = ii[ok], jj[ok]
-        pick = lambda a: np.stack([a[ii, jj], a[ii + 1, jj], a[ii, jj + 1], a[ii + 1, jj + 1]], axis=1)  # noqa: E731
-        return ii, jj, pick(x[..., :2, :2]).reshape(len(ii), 4, 4), pick(f)
+        ii, jj = good_cells(conv & np.isfinite(f[..., :2]).all(axis=-1))
+        return ii, jj, cell_corners(x[..., :2, :2], ii, jj).reshape(len(ii), 4, 4), cell_corners(f, ii, jj)
 
     def nets(self) -> list[Candidate]:
         out = []

@@ -30,7 +30,7 @@ import numpy as np
 from pydantic import Field, field_validator
 
 from ..validation import (DEFAULT_MAX_FORCE_N, ForceN, FormantHz, NonNegative, Point2, Positive, PositionCm, SafeName,
-                          Strict, parse)
+                          Strict, increasing, parse)
 from ..errors import ArticError, UnreachableTarget
 from .epmap import CONTROL_POINTS, JawMaps, Net
 
@@ -73,9 +73,7 @@ class AcousticGoal(Strict):
     @field_validator("formants_hz")
     @classmethod
     def _increasing(cls, v):
-        if any(b <= a for a, b in zip(v, v[1:])):
-            raise ValueError("formants must increase (F1 < F2 < F3)")
-        return v
+        return increasing(v, "formants must increase (F1 < F2 < F3)")
 
 
 class Lips(Strict):
@@ -183,15 +181,23 @@ def invert_cells(corners: np.ndarray, target: np.ndarray, iters: int = 12):
     return u, v, res
 
 
+def good_cells(good: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(ii, jj) of the cells of a 2-D grid whose four corners are ``good`` (na, nb)."""
+    na, nb = good.shape
+    ii, jj = (g.ravel() for g in np.meshgrid(np.arange(na - 1), np.arange(nb - 1), indexing="ij"))
+    ok = good[ii, jj] & good[ii + 1, jj] & good[ii, jj + 1] & good[ii + 1, jj + 1]
+    return ii[ok], jj[ok]
+
+
+def cell_corners(a: np.ndarray, ii: np.ndarray, jj: np.ndarray) -> np.ndarray:
+    """(C, 4, ...) the values of ``a`` (na, nb, ...) at each cell's corners, in the order 00, 10, 01, 11."""
+    return np.stack([a[ii, jj], a[ii + 1, jj], a[ii, jj + 1], a[ii + 1, jj + 1]], axis=1)
+
+
 def _cells(net2: np.ndarray, conv: np.ndarray):
-    """Cells of a 2-D grid (na, nb, 3, 3) of EPs whose four corners settled: indices and corners (C, 4, 3, 2)."""
-    na, nb = conv.shape
-    ii, jj = np.meshgrid(np.arange(na - 1), np.arange(nb - 1), indexing="ij")
-    ii, jj = ii.ravel(), jj.ravel()
-    ok = conv[ii, jj] & conv[ii + 1, jj] & conv[ii, jj + 1] & conv[ii + 1, jj + 1]
-    ii, jj = ii[ok], jj[ok]
-    corners = np.stack([net2[ii, jj], net2[ii + 1, jj], net2[ii, jj + 1], net2[ii + 1, jj + 1]], axis=1)
-    return ii, jj, corners[..., :2, :2]  # tip and dorsum, x and y
+    """Cells of a 2-D grid (na, nb, 3, 3) of EPs whose four corners settled: indices and corners (C, 4, 2, 2)."""
+    ii, jj = good_cells(conv)
+    return ii, jj, cell_corners(net2, ii, jj)[..., :2, :2]  # tip and dorsum, x and y
 
 
 def indecisive_cost(target: TargetSpec, forces: dict[str, float], pred: np.ndarray) -> float:

@@ -186,7 +186,6 @@ def synthesize_tube(tube: Path | str, out: Path | str, duration_s: float, f0_hz:
 def solution_tube(path: Path | str) -> Tube:
     """The simulated area function a solve-target answer records (refined, else verified)."""
     from ..config import read_yaml
-    from ..validation import check_number
 
     doc = read_yaml(path, "solution file")
     if not isinstance(doc, dict) or not ("chosen" in doc or "unreachable" in doc):
