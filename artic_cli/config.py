@@ -366,6 +366,32 @@ class VocalTract(Strict):
         return v
 
 
+class Noise(Strict):
+    """Turbulence noise at the tract's narrowest place (frication and bursts; artic_cli/acoustics/aerodynamics.py):
+    a pressure source just downstream of the constriction whose RMS is ``gain`` times the kinetic pressure drop
+    across it (Stevens 1971: the source strength follows the pressure drop), switched on where the Reynolds
+    number passes ``critical_reynolds`` (Flanagan 1972: about 1800), growing as 1 - (Re_c / Re)^2."""
+
+    enabled: bool = True
+    critical_reynolds: Annotated[float, Field(gt=0, le=1e5, allow_inf_nan=False)] = 1800.0
+    gain: Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)] = 0.05
+    seed: Annotated[int, Field(ge=0)] = 0
+
+
+class Speech(Strict):
+    """How an utterance is spoken (``artic speak``): the force course, the glottis and the lungs."""
+
+    ramp_ms: Annotated[float, Field(ge=0, le=500, allow_inf_nan=False)] = 30.0  # each target's forces ramp in over this
+    lip_ramp_ms: Annotated[float, Field(ge=0, le=500, allow_inf_nan=False)] = 60.0  # the lips and velum move over this
+    voicing_ramp_ms: Annotated[float, Field(ge=1, le=200, allow_inf_nan=False)] = 20.0  # voice on / off
+    lung_pressure_kpa: Annotated[float, Field(gt=0, le=4, allow_inf_nan=False)] = 0.8  # 8 cm H2O, speech at normal effort
+    glottal_area_voiced_cm2: Annotated[float, Field(gt=0, le=2, allow_inf_nan=False)] = 0.05  # its mean while voicing (mean flow about 180 cm^3/s)
+    glottal_area_voiceless_cm2: Annotated[float, Field(gt=0, le=2, allow_inf_nan=False)] = 0.3  # abducted
+    glottal_flow_peak_cm3_s: Annotated[float, Field(gt=0, le=2000, allow_inf_nan=False)] = 300.0  # the voice's AC flow
+    frame_ms: Annotated[float, Field(gt=0, le=50, allow_inf_nan=False)] = 5.0  # tract and formant frames
+    noise: Noise = Noise()
+
+
 class Config(Strict):
     schema_version: Literal[1]
     speaker: Speaker
@@ -379,6 +405,7 @@ class Config(Strict):
     muscle_function: MuscleFunctionSpec = MuscleFunctionSpec()
     acoustics: Acoustics = Acoustics()
     vocal_tract: VocalTract | None = None  # the speaker's tract (required by 'artic vocal-tract')
+    speech: Speech = Speech()
 
 
 

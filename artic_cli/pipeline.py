@@ -37,6 +37,7 @@ class Pipeline(Strict):
     experiments: list[str] = []
     targets: list[str] = []
     vowels: list[str] = []  # configs/targets/vowels/*.yaml
+    utterances: list[str] = []  # configs/utterances/*.yaml
 
 
 def load_pipeline(path: Path | str) -> Pipeline:
@@ -59,6 +60,9 @@ def load_pipeline(path: Path | str) -> Pipeline:
     for name in p.vowels:
         if not (ROOT / "configs" / "targets" / "vowels" / f"{name}.yaml").is_file():
             raise ArticError(f"{path}: vowel '{name}' has no configs/targets/vowels/{name}.yaml")
+    for name in p.utterances:
+        if not (ROOT / "configs" / "utterances" / f"{name}.yaml").is_file():
+            raise ArticError(f"{path}: utterance '{name}' has no configs/utterances/{name}.yaml")
     return p
 
 

@@ -11,8 +11,10 @@ radiation load as the frequency-domain model (a piston in a baffle, parallel R-L
 correction that lowers the formants of a wide mouth.  Each section passes ``1 - section_loss`` of a wave
 (wall and boundary-layer losses lumped).  A closed side branch (the piriform fossae, as the transfer
 function has them) joins at a three-tube junction: one pressure 2 sum(A p_in) / sum(A), each tube's
-outgoing wave that pressure less its incoming one.  The radiated sound
-is the time derivative of the lips' volume velocity, brought to the audio rate by a polyphase filter.
+outgoing wave that pressure less its incoming one.  Turbulence noise
+(frication, bursts) enters as a series pressure source at a junction, half its pressure sent each way.  The
+radiated sound is the time derivative of the lips' volume velocity, brought to the audio rate by a polyphase
+filter.
 """
 
 from __future__ import annotations
@@ -27,7 +29,7 @@ MIN_AREA_CM2 = 1e-4
 
 @njit(cache=True)
 def _line(frame_areas, frame_index, source, glottal_reflection, rho, c, fs, loss, branch_at,
-          branch_areas):  # pragma: no cover - compiled
+          branch_areas, noise, noise_at):  # pragma: no cover - compiled
     n_samples = source.shape[0]
     n = frame_areas.shape[1]
     fwd = np.zeros(n)
@@ -67,6 +69,11 @@ def _line(frame_areas, frame_index, source, glottal_reflection, rho, c, fs, loss
             r = (area[j] - area[j + 1]) / (area[j] + area[j + 1])
             new_f[j + 1] = (1.0 + r) * fwd[j] - r * bwd[j + 1]
             new_b[j] = r * fwd[j] + (1.0 - r) * bwd[j + 1]
+        k_n = noise_at[s]
+        if 0 <= k_n < n - 1:  # a series pressure source between sections k_n and k_n + 1: half each way
+            half = 0.5 * noise[s] / (rho * c)
+            new_f[k_n + 1] += half
+            new_b[k_n] -= half
         if m > 0:
             for k in range(m - 1):
                 r = (branch_areas[k] - branch_areas[k + 1]) / (branch_areas[k] + branch_areas[k + 1])
@@ -117,16 +124,36 @@ def side_branch(at_cm: float, tube_length_cm: float, n: int, branch_length_cm: n
     return max(0, min(k, n - 2)), np.maximum(resample_tube(branch_length_cm, branch_area_cm2, m), MIN_AREA_CM2)
 
 
+def noise_samples(frame_times_s: np.ndarray, rms: np.ndarray, at_fraction: np.ndarray, t_s: np.ndarray, n: int,
+                  seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """White Gaussian noise per internal sample with the frames' RMS (interpolated in time) and the junction it
+    acts at (the nearest frame's place, a fraction of the tract's length from the glottis, as the section of
+    the line's n after which it joins; -1 where the RMS is zero)."""
+    ft = np.asarray(frame_times_s, float) - float(frame_times_s[0])
+    level = np.interp(t_s, ft, np.asarray(rms, float)) if len(ft) > 1 else np.full(len(t_s), float(rms[0]))
+    nearest = np.clip(np.searchsorted(ft, t_s), 0, len(ft) - 1)
+    k = np.clip(np.round(np.asarray(at_fraction, float)[nearest] * n).astype(np.int64) - 1, 0, n - 2)
+    k = np.where(level > 0, k, -1)
+    return level * np.random.default_rng(seed).standard_normal(len(t_s)), k
+
+
 def synthesize(frame_areas: np.ndarray, frame_times_s: np.ndarray, source: np.ndarray, fs_internal: float,
                glottal_reflection: float = 0.97, section_loss: float = 5e-4, rho: float = 1.14e-3,
-               c: float = 35000.0, branch: tuple[int, np.ndarray] | None = None) -> np.ndarray:
+               c: float = 35000.0, branch: tuple[int, np.ndarray] | None = None, flow_peak_cm3_s: float | None = None,
+               noise: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
     """The radiated sound at ``fs_internal`` for areas (frames x N equal sections) at ``frame_times_s`` and a
     source (flow derivative per internal sample); ``branch``: a closed side tube, (the section after which it
-    joins, its areas), from :func:`side_branch`."""
+    joins, its areas), from :func:`side_branch`; ``flow_peak_cm3_s``: the glottal flow's peak (else arbitrary
+    units); ``noise``: a pressure source per internal sample (dyn/cm^2) and the section after which it acts (-1:
+    none), on the same scale as a flow of ``flow_peak_cm3_s``."""
     t = np.arange(len(source)) / fs_internal
     index = np.interp(t, frame_times_s, np.arange(len(frame_times_s))) if len(frame_times_s) > 1 else np.zeros(len(t))
     # the source drives flow: integrate its derivative (leaky, so no drift) before it enters the line
     flow = lfilter([1.0 / fs_internal], [1.0, -0.999], source)
+    peak = float(np.max(np.abs(flow))) if len(flow) else 0.0
+    flow = flow * (flow_peak_cm3_s / peak if flow_peak_cm3_s is not None and peak > 0 else 1e4)
     at, areas = (-1, np.zeros(0)) if branch is None else (int(branch[0]), np.asarray(branch[1], dtype=float))
-    return _line(np.ascontiguousarray(frame_areas, dtype=float), index.astype(float), flow * 1e4,
-                 glottal_reflection, rho, c, float(fs_internal), section_loss, at, areas)
+    p_noise, k_noise = (np.zeros(len(source)), np.full(len(source), -1, np.int64)) if noise is None else noise
+    return _line(np.ascontiguousarray(frame_areas, dtype=float), index.astype(float), flow,
+                 glottal_reflection, rho, c, float(fs_internal), section_loss, at, areas,
+                 np.ascontiguousarray(p_noise, dtype=float), np.ascontiguousarray(k_noise, dtype=np.int64))

@@ -825,6 +825,65 @@ def vocal_tract_cmd(
         out_console.print(f"{'up to date' if p == r.path and r.up_to_date else 'wrote'} {p}", highlight=False)
 
 
+@app.command("speak")
+@handle_errors
+def speak_cmd(
+    utterance: Path = typer.Argument(..., help="Utterance file (YAML): segments (a target or forces, a duration), "
+                                               "an F0 contour, a lip and velum course."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Sound to write (WAV); the TextGrid and NAME.h5 go "
+                                                           "beside it (default data/utterances/NAME.wav)."),
+    maps: Path = typer.Option(Path("data/epmaps.h5"), "--maps", help="EP maps the targets are solved on."),
+    acoustic_maps: Path = typer.Option(Path("data/acoustic_maps.h5"), "--acoustic-maps",
+                                       help="Formants of every EP (vowel targets)."),
+    mesh: Path = typer.Option(Path("data/mesh.h5"), "--mesh", help="Mesh from 'artic build-mesh'."),
+    config: Optional[Path] = typer.Option(None, "--config", help="Config (its 'speech' section: ramps, glottis, "
+                                                                 "lungs, noise)."),
+    solutions: Optional[Path] = typer.Option(None, "--solutions", help="Where the targets' solutions are cached "
+                                                                       "(default: a 'solutions' folder beside --out)."),
+    accept_nearest: bool = typer.Option(False, "--accept-nearest", help="Speak the nearest reachable answer of an "
+                                                                        "unreachable target instead of stopping."),
+    budget: int = typer.Option(8, "--budget", help="Most simulations each target's refinement may spend."),
+    plot: Optional[Path] = typer.Option(None, "--plot", help="Spectrogram with formant tracks, segments and the "
+                                                             "tip/dorsum/jaw heights (PNG)."),
+    animate: Optional[Path] = typer.Option(None, "--animate", help="The midsagittal view moving (GIF)."),
+):
+    """Speak a sequence of targets: each solved once, its forces ramped in at its segment's start and held, the
+    whole simulated with contact, then the tract, formants and sound (WAV, TextGrid, HDF5)."""
+    from ..stages import speak as speak_stage
+
+    check_number("--budget", budget, ge=1)
+    for opt, p, ext in (("--plot", plot, ".png"), ("--animate", animate, ".gif")):
+        if p is not None and (p.suffix.lower() != ext or not p.parent.is_dir()):
+            raise ArticError(f"{opt} {p}: give a {ext} file in an existing folder")
+    say = lambda m: err_console.print(m, highlight=False)  # noqa: E731
+    res = _with_progress("simulating", lambda update: speak_stage.speak(
+        utterance, out, maps, mesh, acoustic_maps, config, solutions, accept_nearest, budget, update, say))
+    if res.up_to_date:
+        out_console.print(f"{res.paths['wav']} is up to date (same utterance, solutions, mesh, config and code)",
+                          highlight=False)
+    else:
+        s = res.spoken
+        out_console.print(f"wrote {res.paths['wav']} ({len(s.audio.samples) / s.audio.sample_rate_hz:.2f} s), "
+                          f"{res.paths['textgrid']}, {res.paths['h5']}", highlight=False)
+        for lab, how in zip(s.plan.labels, s.plan.notes):
+            out_console.print(f"  {lab}: {how}", highlight=False)
+    if plot is not None or animate is not None:
+        from ..stages.synthesize import read_wav
+
+        rec = speak_stage.read(res.paths["h5"])
+        if plot is not None:
+            from ..plots.utterance import plot_utterance
+
+            y, rate = read_wav(res.paths["wav"])
+            out_console.print(f"wrote {plot_utterance(rec, y, rate, plot)}", highlight=False)
+        if animate is not None:
+            from ..plots.utterance import animate_utterance
+            from ..stages.simulate import load_model
+
+            model, _, wall = load_model(mesh, config)
+            out_console.print(f"wrote {animate_utterance(rec, model, wall, animate)}", highlight=False)
+
+
 @app.command("synthesize")
 @handle_errors
 def synthesize_cmd(
@@ -908,6 +967,23 @@ def _plot_fig7(doc: dict, out: Path) -> Path:
     if "figure" not in doc:
         raise ArticError(f"experiment '{doc.get('experiment')}' has no figure; only fig7 draws one")
     return plot_fig7(figure_paths(doc), out)
+
+
+@plot_app.command("utterance")
+@handle_errors
+def plot_utterance_cmd(
+    record: Path = typer.Argument(..., help="An utterance record (NAME.h5 from 'artic speak'); its WAV beside it."),
+    out: Path = typer.Option(..., "--out", help="Picture to write (PNG)."),
+):
+    """Spectrogram of a spoken utterance with our formant tracks and its segments; tip, dorsum and jaw heights
+    below on the same time axis."""
+    from ..plots.utterance import plot_utterance
+    from ..stages import speak as speak_stage
+    from ..stages.synthesize import read_wav
+
+    rec = speak_stage.read(record)
+    y, rate = read_wav(Path(record).parent / str(rec.attrs.get("wav", Path(record).with_suffix(".wav").name)))
+    out_console.print(f"wrote {plot_utterance(rec, y, rate, out)}", highlight=False)
 
 
 @plot_app.command("mesh")

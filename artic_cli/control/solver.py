@@ -331,8 +331,10 @@ def solve_on(jm: JawMaps, target: TargetSpec, reach: float | None = None) -> lis
         point, dist, where = p.nearest_reachable()
         if point is None:
             raise UnreachableTarget(f"target '{target.name}': no settled EP maps to search")
-        raise UnreachableTarget(
+        err = UnreachableTarget(
             f"target '{target.name}': {target.crucial.point} at ({target.crucial.at_cm[0]:.3f}, "
             f"{target.crucial.at_cm[1]:.3f}) cm is not reachable at this jaw position; the nearest reachable point "
             f"is ({point[0]:.3f}, {point[1]:.3f}) cm ({where}), {dist:.3f} cm away")
+        err.nearest_cm = float(dist)  # how far the nearest reachable point is (a caller may settle for it)
+        raise err
     return cands

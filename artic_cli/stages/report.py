@@ -379,8 +379,69 @@ def vowel_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row], l
     return rows, lines + [""] + pictures + [""]
 
 
+EMA_PEAK_CM_S = {"tip": 40.0, "dorsum": 32.0, "jaw": 12.0}  # Table II's EMA ranges the paper cites
+
+
+def utterance_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row], list[str]]:
+    """Each spoken utterance: its segments (how their forces were found, F1 / F2), closures, noise, speeds, the
+    sound and its TextGrid; rows for the measures speech needs."""
+    import os
+
+    from . import speak as speak_stage
+    from .synthesize import read_wav
+
+    out_dir = Path("reports") if out_dir is None else out_dir
+    rows: list[Row] = []
+    lines = ["Each utterance is a list of targets with durations (`configs/utterances/`), spoken by `artic speak "
+             "--accept-nearest`: every target solved once, its forces ramped in over 30 ms at its segment's start "
+             "and held (the paper's static forces), the whole simulated with contact, then tract, formants and "
+             "sound (LF voice, off in voiceless segments; turbulence noise at the narrowest place).  Formants are "
+             "our transfer function's, medians over each segment's middle half.", ""]
+    pictures: list[str] = []
+    for path in sorted((data / "utterances").glob("*.h5")):
+        rec = speak_stage.read(path)
+        wav = path.with_suffix(".wav")
+        y, rate = read_wav(wav)
+        m = speak_stage.measures(rec, y, rate)
+        name = str(rec.attrs.get("name", path.stem))
+        segs = "; ".join(f"{s['label']} ({h}) F1 / F2 {s['f1_hz']:.0f} / {s['f2_hz']:.0f} Hz"
+                         for s, h in zip(m["segments"], rec.how))
+        clos = ", ".join(f"{c['duration_ms']:.0f} ms at {c['start_s']:.2f} s" for c in m["closures"]) or "none"
+        sp = m["peak_speed_cm_s"]
+        tg = path.with_suffix(".TextGrid")
+        lines.append(f"* /{name}/: {segs}; closures: {clos}; narrowest {m['min_constriction_cm2']:.2f} cm^2; peak "
+                     f"speeds tip / dorsum / jaw {sp.get('tip', np.nan):.1f} / {sp.get('dorsum', np.nan):.1f} / "
+                     f"{sp.get('jaw', np.nan):.1f} cm/s; listen: [{wav.name}]({os.path.relpath(wav, out_dir)}), "
+                     f"[{tg.name}]({os.path.relpath(tg, out_dir)})")
+        pictures.append(f"![/{name}/: spectrogram, formant tracks, tip / dorsum / jaw heights](utterance_{path.stem}.png)")
+        vowels = [s for s in m["segments"] if s["label"] not in ("k", "t", "s")]
+        vowel_db = float(np.mean([s["level_db"] for s in vowels])) if vowels else np.nan
+        if name == "aia":
+            f2 = [s["f2_hz"] for s in m["segments"]]
+            rise, fall = f2[1] - f2[0], f2[1] - f2[2]
+            rows.append(Row("/aia/: F2 rise /a/ -> /i/, fall /i/ -> /a/", ">= 600 Hz each (goal)",
+                            f"{rise:+.0f} / {fall:+.0f} Hz", _verdict(rise >= 600 and fall >= 600, ">= 600 Hz")))
+        if name in ("aka", "ata"):
+            c = max(m["closures"], key=lambda c: c["duration_ms"]) if m["closures"] else None
+            ours = "no closure" if c is None else (f"{c['duration_ms']:.0f} ms, {c['level_db'] - vowel_db:+.0f} dB "
+                                                   "against the vowels")
+            ok = c is not None and 40 <= c["duration_ms"] <= 120 and c["level_db"] - vowel_db <= -30
+            rows.append(Row(f"/{name}/: closure", "40-120 ms, >= 30 dB below the vowels (goal)", ours,
+                            _verdict(ok, "a stop")))
+        if name == "asa":
+            s_ = [s for s in m["segments"] if s["label"] == "s"]
+            hf = s_[0]["level_above_3khz_db"] - float(np.mean([s["level_above_3khz_db"] for s in vowels])) if s_ else np.nan
+            rows.append(Row("/asa/: level above 3 kHz, /s/ against the vowels", ">= +20 dB (goal)", f"{hf:+.1f} dB",
+                            _verdict(bool(hf >= 20), "frication")))
+        fast = {k: sp.get(k, np.nan) for k in EMA_PEAK_CM_S}
+        ok = all(fast[k] <= 1.5 * v for k, v in EMA_PEAK_CM_S.items())
+        rows.append(Row(f"/{name}/: peak speeds tip / dorsum / jaw", "<= 40 / 32 / 12 cm/s (EMA, Table II) +50 %",
+                        " / ".join(f"{fast[k]:.1f}" for k in EMA_PEAK_CM_S) + " cm/s", _verdict(ok, "within")))
+    return rows, lines + [""] + pictures + [""]
+
+
 SECTIONS = {"tissue": tissue_section, "articulator": articulator_section, "tract": tract_section, "function": function_rows,
-            "maps": map_section, "vowels": vowel_section}
+            "maps": map_section, "vowels": vowel_section, "utterances": utterance_section}
 
 
 def write_report(data: Path | str = "data", out: Path | str = "reports/paper.md") -> Path:
@@ -392,7 +453,7 @@ def write_report(data: Path | str = "data", out: Path | str = "reports/paper.md"
              "computed by the run, none typed in."]
     for section in REPORT:
         fn = SECTIONS[section.key]
-        rows, extra = fn(data, out.parent) if section.key in ("tract", "vowels") else fn(data)
+        rows, extra = fn(data, out.parent) if section.key in ("tract", "vowels", "utterances") else fn(data)
         lines += ["", f"## {section.title}", ""] + extra
         lines += ["| item | paper | ours | verdict |", "|---|---|---|---|"]
         lines += [f"| {r.item} | {r.paper} | {r.ours} | {r.verdict} |" for r in rows]

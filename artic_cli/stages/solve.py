@@ -139,12 +139,16 @@ def solve_target(target: Path | str | TargetSpec, ctx: Context, out: Path | str 
     if up_to_date(path, prov):
         doc = read(path)
         if "unreachable" in doc:
-            raise UnreachableTarget(doc["unreachable"])
+            err = UnreachableTarget(doc["unreachable"])
+            if "nearest_distance_cm" in doc:
+                err.nearest_cm = float(doc["nearest_distance_cm"])
+            raise err
         return doc, path, True
     try:
         doc = solve(ctx, t, sim, verify, refine, budget)
     except UnreachableTarget as err:  # the answer is written too (make and scripts can report it)
-        write(path, {"target": t.name, "unreachable": str(err), **getattr(err, "answer", {})}, prov)
+        near = {"nearest_distance_cm": err.nearest_cm} if getattr(err, "nearest_cm", None) is not None else {}
+        write(path, {"target": t.name, "unreachable": str(err), **near, **getattr(err, "answer", {})}, prov)
         raise
     write(path, doc, prov)
     return read(path), path, False

@@ -14,7 +14,7 @@ from scipy.signal import resample_poly
 
 from ..acoustics.source import lf_flow_derivative
 from ..acoustics.model import tract_of
-from ..acoustics.synthesis import resample_tube, sections_for, side_branch, synthesize
+from ..acoustics.synthesis import noise_samples, resample_tube, sections_for, side_branch, synthesize
 from ..acoustics.tube import Tube, read_tube_csv
 from ..config import Config, load_config
 from ..errors import ArticError
@@ -72,9 +72,12 @@ def compute(tube: Tube, cfg: Config, duration_s: float, f0_hz: float | None = 11
 
 def compute_frames(lengths_cm: np.ndarray, areas_cm2: np.ndarray, times_s: np.ndarray, cfg: Config,
                    duration_s: float, f0_hz: float | None = 110.0, contour=None, amplitude=None,
-                   aspiration: float = 0.0) -> Audio:
+                   aspiration: float = 0.0, flow_peak_cm3_s: float | None = None, noise=None) -> Audio:
     """Area functions (frames x sections, glottis first) at ``times_s``, interpolated at the line's rate; the
-    line's sections are cut from the frames' mean length (each frame resampled over its own length)."""
+    line's sections are cut from the frames' mean length (each frame resampled over its own length).
+    ``noise``: (RMS dyn/cm^2 (F,), place as a fraction of the length from the glottis (F,), seed), a turbulence
+    source per frame, with the
+    voice's flow peak ``flow_peak_cm3_s`` setting their relative level."""
     ac = STAGE.view(cfg).acoustics
     sy = ac.synthesis
     fs = 2 * sy.sample_rate_hz  # the line runs at twice the audio rate
@@ -89,8 +92,12 @@ def compute_frames(lengths_cm: np.ndarray, areas_cm2: np.ndarray, times_s: np.nd
         fossa = tract_of(Tube(np.array([mean_length]), np.array([1.0])), ac, velum_area_cm2=0.0).branches[0].tube
         branch = side_branch(pf.from_glottis_cm, mean_length, n, fossa.length_cm, fossa.area_cm2,
                              ac.sound_speed_cm_s, fs)
+    pn = None
+    if noise is not None:
+        rms, at_fraction, seed = noise
+        pn = noise_samples(np.asarray(times_s, float), rms, at_fraction, t, n, seed)
     y = synthesize(areas, np.asarray(times_s, float) - float(times_s[0]), src, fs, sy.glottal_reflection,
-                   sy.section_loss, ac.air_density_g_cm3, ac.sound_speed_cm_s, branch)
+                   sy.section_loss, ac.air_density_g_cm3, ac.sound_speed_cm_s, branch, flow_peak_cm3_s, pn)
     y = resample_poly(y, 1, 2)
     peak = float(np.max(np.abs(y))) if len(y) else 0.0
     return Audio(0.9 * y / peak if peak > 0 else y, sy.sample_rate_hz)

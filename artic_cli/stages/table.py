@@ -130,6 +130,14 @@ STAGES: tuple[StageEntry, ...] = (
                "synthesize --solution {out}/vowels/{name}.yaml --duration 0.6 --f0-contour "
                "configs/voice/f0_fall_125_100.csv --config {config} --out {output}",
                inputs=("{out}/vowels/{name}.yaml", "configs/voice/f0_fall_125_100.csv"), items="vowels"),
+    StageEntry("utterances", "artic_cli.stages.speak", "{out}/utterances/{name}.h5",
+               "speak configs/utterances/{name}.yaml --maps {maps} --mesh {mesh} --config {config} "
+               "--acoustic-maps {out}/acoustic_maps.h5 --accept-nearest --out {out}/utterances/{name}.wav",
+               inputs=(MAPS, MESH, "{out}/acoustic_maps.h5", "configs/utterances/{name}.yaml",
+                       "$(wildcard configs/targets/vowels/*.yaml configs/targets/consonants/*.yaml)"),
+               items="utterances",
+               figures=(Figure("{report}/utterance_{name}.png", "plot utterance {output}", "--out {figure}",
+                               "artic_cli.plots.utterance"),)),
 )
 
 
@@ -150,6 +158,7 @@ REPORT: tuple[ReportSection, ...] = (
     ReportSection("maps", "EP maps, dynamic maps and the target solver (sections IV.B and V)",
                   ("epmaps", "dynamic", "solve")),
     ReportSection("vowels", "Vowels from formant targets (beyond the paper)", ("vowels", "vowels-audio")),
+    ReportSection("utterances", "Utterances from target sequences (beyond the paper)", ("utterances",)),
 )
 REPORT_MODULE = "artic_cli.stages.report"
 REPORT_OUTPUT = "{report}/paper.md"

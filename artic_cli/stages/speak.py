@@ -1,0 +1,451 @@
+"""Stage ``utterances``: a sequence of targets in time -> muscle forces in time -> movement -> tract -> sound.
+
+Each segment's target is solved once (``solve-target --refine``; cached by content under the solutions folder);
+its forces switch on at the segment's start with a raised-cosine ramp and hold until the next target
+(:mod:`artic_cli.control.course`).  The whole sequence is simulated from the rest posture with contact; each
+recorded frame gives an area function (lips and velum from the targets, then the utterance's own course) and
+formants; the frames drive the time-domain synthesizer with the LF voice (off in voiceless segments) and a
+turbulence noise source at the narrowest place (:mod:`artic_cli.acoustics.aerodynamics`).
+
+Outputs: the WAV, a Praat TextGrid (one interval per segment) and ``NAME.h5`` (forces, control points,
+area functions, formant tracks, the noise source), each written atomically; the HDF5 file is the stage's
+freshness record and is written last.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from .. import units
+from ..acoustics.aerodynamics import turbulence
+from ..acoustics.tube import Tube
+from ..config import Config, load_config
+from ..control.course import course, raised_cosine
+from ..control.solver import TargetSpec, parse_target
+from ..errors import ArticError, NotPhysical, UnreachableTarget
+from ..io.fingerprint import digest
+from ..io.store import atomic_h5, atomic_path, open_artifact
+from ..mechanics.loads import muscle_force_vector
+from ..mechanics.model import ARTICULATOR_SECTIONS, Control
+from ..mechanics.simulate import Trajectory, run, settle
+from ..schedule import TractEntry
+from ..utterance import Utterance, check_forces, load_utterance, target_path
+from . import acoustics as ac_stage
+from . import mesh as mesh_stage
+from . import simulate as sim_stage
+from . import solve as solve_stage
+from . import synthesize as syn_stage
+from . import vocal_tract as vt_stage
+from .base import Stage, up_to_date
+
+STAGE = Stage(name="utterances", module=__name__,
+              sections=(*ARTICULATOR_SECTIONS, "epmap", "vocal_tract", "acoustics", "speech"),
+              reads=("mesh", "epmaps", "acousticmaps"), kind="utterance", hint="rerun 'artic speak UTTERANCE.yaml'")
+
+
+@dataclass
+class Plan:
+    """What each segment does: its label, start and duration (s), forces (N), lips, port, voicing."""
+
+    labels: list[str]
+    starts_s: np.ndarray
+    durations_s: np.ndarray
+    forces_n: list[dict[str, float]]  # jaw and tongue together
+    lips: list[tuple[float, float]]  # (area cm^2, length cm)
+    ports: list[float]
+    voiced: np.ndarray
+    notes: list[str]  # per segment: how its forces were found
+    solutions: list[str]  # the solution files ('' for given forces)
+
+
+@dataclass
+class Spoken:
+    utterance: Utterance
+    plan: Plan
+    trajectory: Trajectory
+    tracts: object  # vocal_tract.Tracts
+    formants_hz: np.ndarray  # (F, n)
+    noise: object  # aerodynamics.Turbulence
+    glottis_cm2: np.ndarray
+    audio: syn_stage.Audio
+    control_points: dict[str, np.ndarray]  # (F, 3) cm
+    muscle_names: list[str]
+    muscle_force_n: np.ndarray  # (F, M) commanded
+
+
+# --- the plan: targets -> forces ---------------------------------------------------------------------
+
+def _targets(u: Utterance, source: Path | str | None, max_force_n: float) -> list[TargetSpec | None]:
+    out = []
+    for k, s in enumerate(u.segments):
+        if s.target is None:
+            out.append(None)
+        elif isinstance(s.target, dict):
+            out.append(parse_target(s.target, f"{source}: segments[{k}].target", max_force_n))
+        else:
+            out.append(_load_target_file(target_path(s.target, source), max_force_n))
+    return out
+
+
+def _load_target_file(path: Path, max_force_n: float) -> TargetSpec:
+    from ..config import read_yaml
+
+    return parse_target(read_yaml(path, "target file"), str(path), max_force_n)
+
+
+def solution_forces(doc: dict) -> tuple[dict[str, float], bool, str]:
+    """The forces a solution document settles on (jaw and tongue together), whether they reach the target,
+    and which answer they are."""
+    jaw = {k: float(v) for k, v in (doc.get("jaw") or {}).get("forces_n", {}).items()}
+    for key in ("refined", "chosen", "nearest"):
+        if key in doc and "forces_n" in doc[key]:
+            reached = key == "chosen" or (key == "refined" and bool(doc[key].get("converged")))
+            return {**jaw, **{k: float(v) for k, v in doc[key]["forces_n"].items()}}, reached, key
+    raise ArticError(f"solution of '{doc.get('target')}' holds no forces; rerun 'artic solve-target'")
+
+
+def _nearer(t: TargetSpec, err: UnreachableTarget) -> TargetSpec | None:
+    """A spatial target whose tolerance reaches the nearest reachable point (to speak the nearest answer)."""
+    dist = getattr(err, "nearest_cm", None)
+    if t.crucial is None or dist is None:
+        return None
+    crucial = t.crucial.model_copy(update={"tolerance_cm": float(dist) * 1.05 + 0.01})
+    return t.model_copy(update={"crucial": crucial, "name": f"{t.name}-nearest"})
+
+
+def plan(u: Utterance, cfg: Config, source: Path | str | None = None, maps: Path | str = "data/epmaps.h5",
+         mesh: Path | str = "data/mesh.h5", acoustic_maps: Path | str | None = "data/acoustic_maps.h5",
+         config: Path | str | None = None, solutions: Path | str = "data/utterances/solutions",
+         accept_nearest: bool = False, budget: int = 8,
+         say: Callable[[str], None] | None = None) -> Plan:
+    """Solve every segment's target (cached) and collect the forces, lips and voicing of each segment."""
+    targets = _targets(u, source, cfg.muscles.max_force_n)
+    vt = vt_stage.speaker_tract(cfg)
+    default_lips = (float(vt.lips.area_cm2), float(vt.lips.length_cm))
+    ctx = sim = voicer = None
+    if any(t is not None for t in targets):
+        ctx = solve_stage.load_context(maps, None, mesh)
+        if any(t is not None and t.acoustic is not None for t in targets):
+            solve_stage.add_formants(ctx, maps, mesh, config, acoustic_maps)
+            voicer = solve_stage.simulator(mesh, config, voiced=True)
+        if any(t is not None and t.acoustic is None for t in targets):
+            sim = voicer.sim if voicer is not None else solve_stage.simulator(mesh, config)
+    labels, forces, lips, ports, notes, files = [], [], [], [], [], []
+    done: dict[str, tuple] = {}
+    for k, (s, t) in enumerate(zip(u.segments, targets)):
+        if t is None:
+            labels.append(s.label or "forces")
+            forces.append(dict(s.forces_n))
+            lips.append(default_lips)
+            ports.append(float(vt.velum_port_cm2))
+            notes.append("forces given")
+            files.append("")
+            continue
+        key = digest(t.model_dump(mode="json"))
+        if key not in done:
+            done[key] = _solve(t, k, ctx, sim, voicer, cfg, config, Path(solutions), mesh, accept_nearest, budget, say)
+        f, note, path = done[key]
+        labels.append(s.label or t.name)
+        forces.append(f)
+        lips.append(t.lip_tube(default_lips) if t.acoustic is not None else default_lips)
+        ports.append(float(vt.velum_port_cm2 if t.velum_port_cm2 is None else t.velum_port_cm2))
+        notes.append(note)
+        files.append(str(path))
+    starts = np.array(u.starts_ms()) / 1e3
+    return Plan(labels=labels, starts_s=starts, durations_s=np.array([s.duration_ms for s in u.segments]) / 1e3,
+                forces_n=forces, lips=lips, ports=ports, voiced=np.array([s.voiced for s in u.segments]),
+                notes=notes, solutions=files)
+
+
+def _solve(t: TargetSpec, k: int, ctx, sim, voicer, cfg, config, folder: Path, mesh, accept_nearest: bool,
+           budget: int, say) -> tuple[dict, str, Path]:
+    from ..stages.mesh import read as read_mesh
+
+    mesh_sha = read_mesh(mesh, cfg).content_sha256
+    runner = voicer if t.acoustic is not None else sim
+    out = folder / f"{t.name}-{digest(t.model_dump(mode='json'))[:8]}.yaml"
+    try:
+        doc, path, fresh = solve_stage.solve_target(t, ctx, out, runner, False, True, budget, config, mesh_sha)
+    except UnreachableTarget as err:
+        if not accept_nearest:
+            raise UnreachableTarget(f"segment {k}: {err}; give --accept-nearest to speak the nearest reachable "
+                                    "answer") from None
+        wider = _nearer(t, err)
+        if wider is None:  # an acoustic target: the written answer holds the nearest force set
+            from .solve import read as read_solution
+
+            doc, path = read_solution(out), out
+        else:
+            doc, path, fresh = solve_stage.solve_target(wider, ctx, folder / f"{wider.name}-"
+                                                        f"{digest(wider.model_dump(mode='json'))[:8]}.yaml",
+                                                        runner, False, True, budget, config, mesh_sha)
+        forces, _, which = solution_forces(doc)
+        if say:
+            say(f"segment {k} ({t.name}): unreachable, speaking the nearest answer ({which})")
+        return forces, f"nearest ({which})", path
+    forces, reached, which = solution_forces(doc)
+    if not reached:
+        if not accept_nearest:
+            raise UnreachableTarget(f"segment {k}: target '{t.name}' not reached by the refinement (see {path}); "
+                                    "give --accept-nearest to speak the best answer found")
+        if say:
+            say(f"segment {k} ({t.name}): refinement did not reach the tolerance; speaking its best answer")
+        return forces, f"best, not within tolerance ({which})", path
+    return forces, f"solved ({which})", path
+
+
+# --- the run: forces -> movement -> tract -> sound -------------------------------------------------------
+
+def ramp_weights(starts_s: np.ndarray, values: np.ndarray, ramp_s: float, t: np.ndarray) -> np.ndarray:
+    """A per-segment value (K,) at times ``t``, moving to each segment's value over ``ramp_s`` from its start."""
+    f = course(starts_s, np.asarray(values, float)[:, None], ramp_s, initial=np.asarray(values[:1], float))
+    return np.array([f(float(x))[0] for x in t])
+
+
+def compute(u: Utterance, p: Plan, cfg: Config, mesh, wall, progress=None, model=None) -> Spoken:
+    """Simulate the plan's force course from the rest posture and voice it (``model``: the articulator of
+    ``mesh``, ``wall`` and ``cfg``, if already built)."""
+    view = STAGE.view(cfg)
+    sp = view.speech
+    model = sim_stage.build(cfg, mesh, wall) if model is None else model
+    names = list(model.drivable())
+    for k, f in enumerate(p.forces_n):
+        bad = [m for m in f if m not in names]
+        if bad:
+            raise ArticError(f"segment {k}: muscle '{bad[0]}' is unknown; valid: {', '.join(names)}")
+    vectors = np.array([muscle_force_vector(model, f) for f in p.forces_n])
+    ramp_s = units.ms_to_s(sp.ramp_ms if u.ramp_ms is None else u.ramp_ms)
+    force_at = course(p.starts_s, vectors, ramp_s)
+    zero = np.zeros((model.n_nodes, 3))
+    start = settle(model)
+    duration = float(p.starts_s[-1] + p.durations_s[-1])
+    dt = units.ms_to_s(view.simulation.dt_ms)
+    every = max(1, int(round(units.ms_to_s(sp.frame_ms) / dt)))
+    traj, _ = run(model, start, lambda t: Control(node_force=zero, muscle_force=force_at(t)), duration, dt,
+                  record_every=every, progress=progress, keep_partial=True)
+    bad = sim_stage.problems(traj, model.volume_constraint)
+    if bad:
+        raise NotPhysical(f"utterance '{u.name}': the simulation is not physical ({'; '.join(bad)}); nothing written")
+    # the tract, frame by frame
+    vtc = vt_stage.speaker_tract(cfg)
+    shapes = vt_stage.shapes_of(traj.x, traj.time, mesh, model.rest, np.asarray(model.node_sets["mandible"]))
+    lip_ramp = sp.lip_ramp_ms
+    entries = [TractEntry(at_ms=float(s * 1e3), ramp_ms=lip_ramp if k else 0.0, lip_area_cm2=a, lip_length_cm=l,
+                          velum_port_cm2=port)
+               for k, (s, (a, l), port) in enumerate(zip(p.starts_s, p.lips, p.ports))]
+    controls = vt_stage.controls_for(vtc, traj.time, entries + list(u.tract))
+    tracts = vt_stage.compute(vtc, cfg.speaker.wall, shapes, controls)
+    tubes = [Tube(tracts.af.length_cm[k], tracts.af.area_cm2[k]) for k in range(tracts.n_frames)]
+    ac = ac_stage.compute(tubes, cfg, velum_area_cm2=controls["velum_port_cm2"],
+                          port_from_glottis_cm=ac_stage.port_positions(tracts))
+    formants_hz = np.where((tracts.af.area_cm2.min(axis=1) > 0)[:, None], ac.formants_hz, np.nan)  # closed: none
+    # the glottis and the air: voiced segments adduct it, voiceless ones open it
+    voiced = p.voiced.astype(float)
+    v_ramp = units.ms_to_s(sp.voicing_ramp_ms)
+    voicing = ramp_weights(p.starts_s, voiced, v_ramp, traj.time)
+    glottis = sp.glottal_area_voiceless_cm2 + (sp.glottal_area_voiced_cm2 - sp.glottal_area_voiceless_cm2) * voicing
+    aco = view.acoustics
+    tb = turbulence(tracts.af.length_cm, tracts.af.area_cm2, glottis, units.kpa_to_cgs(sp.lung_pressure_kpa),
+                    aco.air_density_g_cm3, aco.air_viscosity_dyn_s_cm2, sp.noise.critical_reynolds, sp.noise.gain)
+    noise = None
+    if sp.noise.enabled:
+        noise = (tb.noise_rms_dyn_cm2, tb.at_cm / tracts.af.length_cm.sum(axis=1), sp.noise.seed)
+    amplitude = list(zip(traj.time.tolist(), voicing.tolist()))
+    audio = syn_stage.compute_frames(tracts.af.length_cm, tracts.af.area_cm2, traj.time, cfg, duration,
+                                     contour=[(float(a), float(b)) for a, b in u.f0_hz] if len(u.f0_hz) > 1 else None,
+                                     f0_hz=float(u.f0_hz[0][1]), amplitude=amplitude,
+                                     flow_peak_cm3_s=sp.glottal_flow_peak_cm3_s, noise=noise)
+    cps = {name: traj.x[:, idx] for name, idx in model.control_points().items()}
+    commanded = np.array([force_at(float(t)) for t in traj.time])
+    return Spoken(utterance=u, plan=p, trajectory=traj, tracts=tracts, formants_hz=formants_hz, noise=tb,
+                  glottis_cm2=glottis, audio=audio, control_points=cps, muscle_names=list(model.muscle_names),
+                  muscle_force_n=units.dyn_to_newton(commanded))
+
+
+# --- files ---------------------------------------------------------------------------------------------
+
+def textgrid_path(wav: Path | str) -> Path:
+    return Path(wav).with_suffix(".TextGrid")
+
+
+def h5_path(wav: Path | str) -> Path:
+    return Path(wav).with_suffix(".h5")
+
+
+def write_textgrid(path: Path | str, p: Plan) -> Path:
+    """One interval tier 'segments' (Praat reads it directly)."""
+    from praatio import textgrid
+
+    edges = [round(float(v), 9) for v in (*p.starts_s, p.starts_s[-1] + p.durations_s[-1])]
+    tier = textgrid.IntervalTier("segments", [(a, b, lab) for a, b, lab in zip(edges[:-1], edges[1:], p.labels)],
+                                 0.0, edges[-1])
+    tg = textgrid.Textgrid()
+    tg.addTier(tier)
+    with atomic_path(path, ".TextGrid") as tmp:
+        tg.save(str(tmp), format="long_textgrid", includeBlankSpaces=True)
+    return Path(path)
+
+
+def write(wav: Path | str, s: Spoken, prov=None) -> dict[str, Path]:
+    """The WAV, the TextGrid, then the HDF5 record (last: it is what says the three are up to date)."""
+    syn_stage.write(wav, s.audio)
+    tg = write_textgrid(textgrid_path(wav), s.plan)
+    h5 = h5_path(wav)
+    p, tr = s.plan, s.tracts
+    with atomic_h5(h5, "utterance", prov) as f:
+        f.attrs.update({"name": s.utterance.name, "duration_s": float(p.starts_s[-1] + p.durations_s[-1]),
+                        "wav": Path(wav).name, "textgrid": tg.name,
+                        "max_abs_volume_change": float(np.nanmax(np.abs(s.trajectory.volume_change))),
+                        "inverted_bricks_max": int(s.trajectory.inverted.max())})
+        g = f.create_group("segments")
+        g.create_dataset("label", data=np.array(p.labels, dtype="S"))
+        g.create_dataset("start", data=p.starts_s).attrs["units"] = "s"
+        g.create_dataset("duration", data=p.durations_s).attrs["units"] = "s"
+        g.create_dataset("voiced", data=p.voiced)
+        g.create_dataset("how", data=np.array(p.notes, dtype="S"))
+        g.create_dataset("solution", data=np.array(p.solutions, dtype="S"))
+        g.create_dataset("lip_area", data=np.array([a for a, _ in p.lips])).attrs["units"] = "cm^2"
+        g.create_dataset("lip_length", data=np.array([b for _, b in p.lips])).attrs["units"] = "cm"
+        names = sorted({m for f_ in p.forces_n for m in f_})
+        g.attrs["force_names"] = names
+        g.create_dataset("forces", data=np.array([[f_.get(m, 0.0) for m in names] for f_ in p.forces_n])
+                         ).attrs["units"] = "N (rows: segments; columns: force_names)"
+        f.create_dataset("time", data=s.trajectory.time).attrs["units"] = "s"
+        for name, xyz in s.control_points.items():
+            f.create_dataset(f"control_points/{name}", data=xyz).attrs["units"] = "cm"
+        m = f.create_group("muscles")
+        m.attrs["names"] = s.muscle_names
+        m.create_dataset("commanded", data=s.muscle_force_n, compression="gzip").attrs["units"] = "N"
+        m.create_dataset("tension", data=units.dyn_to_newton(s.trajectory.muscle_force), compression="gzip"
+                         ).attrs["units"] = "N"
+        a = f.create_group("area_function")
+        a.create_dataset("length", data=tr.af.length_cm, compression="gzip").attrs["units"] = "cm"
+        a.create_dataset("area", data=tr.af.area_cm2, compression="gzip").attrs["units"] = "cm^2"
+        a.attrs["order"] = "glottis to lips, the lip tube last"
+        for k_, v in tr.controls.items():
+            f.create_dataset(f"tract_controls/{k_}", data=v)
+        f.create_dataset("formants", data=s.formants_hz).attrs["units"] = "Hz (NaN: none; a closed tract)"
+        n = f.create_group("aerodynamics")
+        n.create_dataset("glottis", data=s.glottis_cm2).attrs["units"] = "cm^2"
+        n.create_dataset("flow", data=s.noise.flow_cm3_s).attrs["units"] = "cm^3/s"
+        n.create_dataset("reynolds", data=s.noise.reynolds)
+        n.create_dataset("noise_rms", data=s.noise.noise_rms_dyn_cm2).attrs["units"] = "dyn/cm^2"
+        n.create_dataset("constriction", data=s.noise.constriction_cm2).attrs["units"] = "cm^2"
+        n.create_dataset("noise_at", data=s.noise.at_cm).attrs["units"] = "cm from the glottis"
+        f.create_dataset("volume_change", data=s.trajectory.volume_change).attrs["units"] = "fraction"
+        f.create_dataset("inverted_bricks", data=s.trajectory.inverted)
+        if s.trajectory.contact_count is not None:
+            f.create_dataset("contact_count", data=s.trajectory.contact_count)
+        f.create_dataset("positions", data=s.trajectory.x.astype(np.float32), compression="gzip"
+                         ).attrs["units"] = "cm (every node, every frame)"
+    return {"wav": Path(wav), "textgrid": tg, "h5": h5}
+
+
+@dataclass
+class Record:
+    """An utterance file read back (what plots and checks need)."""
+
+    attrs: dict
+    labels: list[str]
+    starts_s: np.ndarray
+    durations_s: np.ndarray
+    voiced: np.ndarray
+    how: list[str]
+    time_s: np.ndarray
+    control_points: dict[str, np.ndarray]
+    formants_hz: np.ndarray
+    area_cm2: np.ndarray
+    length_cm: np.ndarray
+    noise_rms: np.ndarray
+    positions_cm: np.ndarray
+    volume_change: np.ndarray
+
+
+def read(path: Path | str) -> Record:
+    with open_artifact(path, "utterance", STAGE.hint) as f:
+        try:
+            g = f["segments"]
+            dec = lambda a: [v.decode() if isinstance(v, bytes) else str(v) for v in a]  # noqa: E731
+            return Record(attrs=dict(f.attrs), labels=dec(g["label"][()]), starts_s=g["start"][()],
+                          durations_s=g["duration"][()], voiced=g["voiced"][()], how=dec(g["how"][()]),
+                          time_s=f["time"][()], control_points={k: v[()] for k, v in f["control_points"].items()},
+                          formants_hz=f["formants"][()], area_cm2=f["area_function/area"][()],
+                          length_cm=f["area_function/length"][()], noise_rms=f["aerodynamics/noise_rms"][()],
+                          positions_cm=f["positions"][()], volume_change=f["volume_change"][()])
+        except (KeyError, ValueError, OSError) as err:
+            raise ArticError(f"{path} is damaged or incomplete ({type(err).__name__}); {STAGE.hint}") from None
+
+
+# --- the file-level entry ------------------------------------------------------------------------------
+
+@dataclass
+class SpeakResult:
+    paths: dict[str, Path]
+    spoken: Spoken | None  # None when the files were up to date
+    up_to_date: bool = False
+
+
+def _check_out(out: Path | str) -> Path:
+    out = Path(out)
+    if out.suffix.lower() != ".wav":
+        raise ArticError(f"--out {out}: give a .wav file name")
+    return out
+
+
+def speak(utterance: Path | str, out: Path | str | None = None, maps: Path | str = "data/epmaps.h5",
+          mesh: Path | str = "data/mesh.h5", acoustic_maps: Path | str | None = "data/acoustic_maps.h5",
+          config: Path | str | None = None, solutions: Path | str | None = None, accept_nearest: bool = False,
+          budget: int = 8, progress=None, say: Callable[[str], None] | None = None) -> SpeakResult:
+    """Speak an utterance file: WAV, TextGrid and HDF5 (``out``: the WAV; default data/utterances/NAME.wav).
+    A record that already holds this recipe (the utterance, its targets' solutions, mesh, config, code) is
+    left alone."""
+    u = load_utterance(utterance)
+    cfg = load_config(config)
+    out = _check_out(out if out is not None else Path("data/utterances") / f"{u.name}.wav")
+    m = mesh_stage.read(mesh, cfg)
+    model = sim_stage.build(cfg, m.mesh, m.wall)
+    check_forces(u, list(model.drivable()), str(utterance))
+    folder = Path(solutions) if solutions is not None else out.parent / "solutions"
+    p = plan(u, cfg, utterance, maps, mesh, acoustic_maps, config, folder, accept_nearest, budget, say)
+    prov = STAGE.provenance(cfg, inputs={"mesh": m.content_sha256, "utterance": digest(u.model_dump(mode="json")),
+                                         "plan": digest({"forces": p.forces_n, "lips": p.lips, "ports": p.ports,
+                                                         "voiced": p.voiced.tolist(), "labels": p.labels})})
+    paths = {"wav": out, "textgrid": textgrid_path(out), "h5": h5_path(out)}
+    if up_to_date(paths["h5"], prov) and paths["wav"].is_file() and paths["textgrid"].is_file():
+        return SpeakResult(paths, None, up_to_date=True)
+    s = compute(u, p, cfg, m.mesh, m.wall, progress, model)
+    return SpeakResult(write(out, s, prov), s)
+
+
+# --- what an utterance did, measured ---------------------------------------------------------------------
+
+def measures(rec: Record, samples: np.ndarray, rate_hz: int) -> dict:
+    """Per segment: median F1/F2 of our tracks over its middle half, its level (dB) overall and above 3 kHz;
+    the closures (frames with a zero area) and their level; peak speeds of the control points (cm/s)."""
+    from ..acoustics.measures import band_level_db, runs
+
+    t = rec.time_s
+    segs = []
+    for lab, s0, d in zip(rec.labels, rec.starts_s, rec.durations_s):
+        mid = (t >= s0 + 0.25 * d) & (t <= s0 + 0.75 * d)
+        fm = rec.formants_hz[mid]
+        med = [float(np.nanmedian(fm[:, k])) if np.isfinite(fm[:, k]).any() else float("nan") for k in (0, 1)]
+        segs.append({"label": lab, "start_s": float(s0), "duration_s": float(d), "f1_hz": med[0], "f2_hz": med[1],
+                     "level_db": band_level_db(samples, rate_hz, s0 + 0.25 * d, s0 + 0.75 * d),
+                     "level_above_3khz_db": band_level_db(samples, rate_hz, s0 + 0.25 * d, s0 + 0.75 * d, 3000.0)})
+    closed = rec.area_cm2.min(axis=1) <= 0.0
+    closures = []
+    for a, b in runs(closed):
+        t0, t1 = float(t[a]), float(t[min(b, len(t) - 1)])
+        closures.append({"start_s": t0, "end_s": t1, "duration_ms": 1e3 * (t1 - t0),
+                         "level_db": band_level_db(samples, rate_hz, t0 + 0.005, max(t1 - 0.005, t0 + 0.01))})
+    dt = np.diff(t)
+    speeds = {name: float(np.max(np.linalg.norm(np.diff(xyz[:, :2], axis=0), axis=1) / dt)) if len(dt) else 0.0
+              for name, xyz in rec.control_points.items()}
+    return {"segments": segs, "closures": closures, "peak_speed_cm_s": speeds,
+            "max_volume_change": float(np.nanmax(np.abs(rec.volume_change))),
+            "min_constriction_cm2": float(rec.area_cm2.min())}

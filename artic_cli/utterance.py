@@ -1,0 +1,116 @@
+"""Utterances: a sequence of targets in time, with a voice (YAML, validated on load).
+
+Example::
+
+    name: aka
+    f0_hz: [[0.0, 125], [0.6, 100]]      # [time_s, F0 Hz] points, times rising; between them linear
+    ramp_ms: 30                          # optional: each target's forces ramp in over this (config speech.ramp_ms)
+    segments:
+      - {target: configs/targets/vowels/a.yaml, duration_ms: 250}
+      - {target: configs/targets/consonants/k.yaml, duration_ms: 80, voiced: false}
+      - target: {name: a_open, jaw: {forces_n: {JO: 2.5}}, acoustic: {formants_hz: [753, 1385]}}   # inline
+        duration_ms: 250
+      - {forces_n: {JO: 1.0, GGp: 2.0}, duration_ms: 100, label: push}     # forces given, nothing solved
+    tract:                               # optional lip and velum course on top of the targets' lips
+      - {at_ms: 250, ramp_ms: 40, lip_area_cm2: 0.0}
+
+A target path is read relative to the working folder, else to the utterance file's folder.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+from pydantic import Field, field_validator, model_validator
+
+from .config import read_yaml
+from .errors import ArticError
+from .schedule import TractEntry
+from .validation import DurationMs, ForceN, SafeName, Strict, parse
+
+MAX_UTTERANCE_MS = 20000.0
+
+
+class Segment(Strict):
+    target: str | dict | None = None  # a target file, or a target inline
+    forces_n: dict[str, ForceN] | None = None  # ... or the forces themselves (muscles, jaw units, groups)
+    duration_ms: DurationMs
+    voiced: bool = True
+    label: SafeName | None = None  # the TextGrid's label (default: the target's name)
+
+    @model_validator(mode="after")
+    def _one_source(self):
+        if (self.target is None) == (self.forces_n is None):
+            raise ValueError("give either 'target' (a target file or one inline) or 'forces_n', one of them")
+        return self
+
+
+class Utterance(Strict):
+    name: SafeName = "utterance"
+    segments: Annotated[list[Segment], Field(min_length=1)]
+    f0_hz: list[Annotated[list[Annotated[float, Field(allow_inf_nan=False)]], Field(min_length=2, max_length=2)]] = \
+        [[0.0, 120.0]]
+    ramp_ms: Annotated[float, Field(ge=0, le=500, allow_inf_nan=False)] | None = None
+    tract: list[TractEntry] = []
+
+    @field_validator("f0_hz")
+    @classmethod
+    def _contour(cls, v):
+        if not v:
+            raise ValueError("give at least one [time_s, f0_hz] point")
+        for k, (t, f) in enumerate(v):
+            if t < 0:
+                raise ValueError(f"point {k}: time {t:g} s is negative")
+            if not 50 <= f <= 500:
+                raise ValueError(f"point {k}: F0 {f:g} Hz is outside 50-500 Hz")
+        times = [t for t, _ in v]
+        if any(b <= a for a, b in zip(times, times[1:])):
+            raise ValueError("times must rise strictly (no overlapping or unsorted points)")
+        return v
+
+    @model_validator(mode="after")
+    def _length(self):
+        total = self.duration_ms
+        if total > MAX_UTTERANCE_MS:
+            raise ValueError(f"the segments last {total:g} ms, above the {MAX_UTTERANCE_MS:g}-ms limit")
+        return self
+
+    @property
+    def duration_ms(self) -> float:
+        return float(sum(s.duration_ms for s in self.segments))
+
+    def starts_ms(self) -> list[float]:
+        out, t = [], 0.0
+        for s in self.segments:
+            out.append(t)
+            t += s.duration_ms
+        return out
+
+
+def parse_utterance(data: object, source: str = "<utterance>") -> Utterance:
+    return parse(Utterance, data, source, "utterance (with 'segments', each a target or forces_n and a duration_ms)",
+                 "fix the utterance and rerun")
+
+
+def load_utterance(path: Path | str) -> Utterance:
+    return parse_utterance(read_yaml(path, "utterance file"), str(path))
+
+
+def target_path(ref: str, utterance_path: Path | str | None) -> Path:
+    """A segment's target file: relative to the working folder, else to the utterance's folder."""
+    p = Path(ref)
+    if p.is_file() or p.is_absolute() or utterance_path is None:
+        return p
+    beside = Path(utterance_path).parent / p
+    return beside if beside.is_file() else p
+
+
+def check_forces(u: Utterance, valid: list[str], source: str) -> None:
+    for k, s in enumerate(u.segments):
+        for name in (s.forces_n or {}):
+            if name not in valid:
+                raise ArticError(f"{source}: segments[{k}].forces_n: '{name}' is unknown; valid: {', '.join(valid)}")
+
+
+__all__ = ["Segment", "Utterance", "load_utterance", "parse_utterance", "target_path", "check_forces"]

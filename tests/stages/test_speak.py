@@ -1,0 +1,155 @@
+"""`artic speak`: bad utterances are one line and exit 2 with nothing written; a spoken sequence gives a WAV,
+a TextGrid Praat reads and a record; a lip closure is silent and its release noisy; a narrow channel makes
+frication that the noise switch takes away; the force course ramps and holds as the paper's controller."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from artic_cli.acoustics.aerodynamics import flow, noise_rms, reynolds
+from artic_cli.acoustics.measures import band_level_db
+from artic_cli.cli.main import app
+from artic_cli.control.course import course
+from artic_cli.stages import speak
+from artic_cli.stages.synthesize import read_wav
+
+from conftest import ROOT
+
+RUNNER = CliRunner()
+
+
+def _run(*args):
+    res = RUNNER.invoke(app, [str(a) for a in args])
+    assert res.exception is None or isinstance(res.exception, SystemExit), repr(res.exception)
+    return res
+
+
+def _write(path, doc):
+    path.write_text(yaml.safe_dump(doc))
+    return path
+
+
+A = {"forces_n": {"JO": 2.5}, "duration_ms": 150, "label": "a"}
+
+
+@pytest.mark.parametrize("doc, says", [
+    ({"segments": [dict(A, duration_ms=0)]}, "segments.0.duration_ms"),
+    ({"segments": [dict(A, duration_ms=-20)]}, "segments.0.duration_ms"),
+    ({"segments": [A], "f0_hz": [[0, 40]]}, "outside 50-500 Hz"),
+    ({"segments": [A], "f0_hz": [[0, 120], [0.3, 600]]}, "outside 50-500 Hz"),
+    ({"segments": [A], "f0_hz": [[0.2, 120], [0.1, 110]]}, "rise strictly"),
+    ({"segments": [A], "f0_hz": [[0.1, 120], [0.1, 110]]}, "rise strictly"),
+    ({"segments": [A], "f0_hz": [[0.0, float("nan")]]}, "f0_hz"),
+    ({"segments": []}, "segments"),
+    ({"segments": [{"duration_ms": 100}]}, "either 'target'"),
+    ({"segments": [dict(A, target="configs/targets/velar.yaml")]}, "either 'target'"),
+    ({"segments": [{"target": "no/such/target.yaml", "duration_ms": 100}]}, "target file not found"),
+    ({"segments": [dict(A, forces_n={"XYZ": 1.0})]}, "'XYZ' is unknown"),
+    ({"segments": [dict(A, forces_n={"GGp": -1.0})]}, "forces_n.GGp"),
+    ({"segments": [{"target": {"name": "x", "crucial": {"point": "tip", "at_cm": [0, 0]}, "acoustic":
+                                {"formants_hz": [500, 1500]}}, "duration_ms": 100}]}, "one of them"),
+])
+def test_a_bad_utterance_is_one_line_and_exit_2_with_nothing_written(tmp_path, mesh_file, doc, says):
+    u = _write(tmp_path / "u.yaml", doc)
+    res = _run("speak", u, "--mesh", mesh_file, "--out", tmp_path / "out" / "u.wav", "--maps", tmp_path / "none.h5")
+    assert res.exit_code == 2, res.output
+    assert says in res.output and "Traceback" not in res.output, res.output
+    assert not (tmp_path / "out").exists()
+
+
+def test_the_force_course_ramps_from_where_it_got_and_holds():
+    f = course([0.0, 0.1, 0.12], np.array([[4.0], [0.0], [2.0]]), 0.03)
+    assert f(0.0)[0] == 0.0 and f(0.015)[0] == pytest.approx(2.0) and f(0.05)[0] == 4.0 and f(0.099)[0] == 4.0
+    # the second ramp is cut short at 0.12 s (two thirds of the way: 4 -> 1); the third starts from there
+    at = f(0.12 - 1e-9)[0]
+    assert at == pytest.approx(4.0 * (0.5 + 0.5 * np.cos(np.pi * 2 / 3)), abs=1e-6)
+    assert f(0.135)[0] == pytest.approx(at + (2.0 - at) * 0.5) and f(0.5)[0] == 2.0
+
+
+def test_the_air_stops_at_a_closure_and_is_turbulent_in_a_narrow_channel():
+    rho, mu = 1.14e-3, 1.86e-4
+    ps = 8000.0  # dyn/cm^2 (0.8 kPa)
+    assert flow(ps, 0.3, 0.0, rho) == 0.0
+    u = flow(ps, 0.3, 0.08, rho)
+    assert 250 < u < 320  # Bernoulli through both orifices: about 290 cm^3/s
+    assert reynolds(u, 0.08, rho, mu) > 1800 > reynolds(flow(ps, 0.05, 3.0, rho), 3.0, rho, mu)
+    assert noise_rms(u, 0.08, rho, mu, 1800.0, 0.05) > 100 * noise_rms(flow(ps, 0.05, 3.0, rho), 3.0, rho, mu,
+                                                                       1800.0, 0.05)
+
+
+LAB = {"name": "lab", "f0_hz": [[0.0, 125], [0.75, 100]],
+       "segments": [dict(A, duration_ms=200), {"forces_n": {"JO": 0.5}, "duration_ms": 100, "label": "p",
+                                                 "voiced": False},
+                    dict(A), {"forces_n": {"JO": 0.5}, "duration_ms": 150, "label": "f", "voiced": False},
+                    dict(A)],
+       "tract": [{"at_ms": 200, "ramp_ms": 15, "lip_area_cm2": 0.0}, {"at_ms": 300, "ramp_ms": 10, "lip_area_cm2": 3.0},
+                 {"at_ms": 450, "ramp_ms": 20, "lip_area_cm2": 0.08}, {"at_ms": 600, "ramp_ms": 20, "lip_area_cm2": 3.0}]}
+
+
+@pytest.fixture(scope="module")
+def spoken(tmp_path_factory, mesh_file):
+    """/apa/ and a bilabial fricative between open-jaw vowels: the lips closed, then a narrow lip channel."""
+    tmp = tmp_path_factory.mktemp("speak")
+    u = _write(tmp / "lab.yaml", LAB)
+    res = _run("speak", u, "--mesh", mesh_file, "--out", tmp / "lab.wav", "--plot", tmp / "lab.png")
+    assert res.exit_code == 0, res.output
+    return tmp
+
+
+def test_a_spoken_sequence_writes_its_sound_textgrid_and_record(spoken, mesh_file):
+    rec = speak.read(spoken / "lab.h5")
+    assert rec.labels == ["a", "p", "a", "f", "a"]
+    y, rate = read_wav(spoken / "lab.wav")
+    assert len(y) / rate == pytest.approx(0.75, abs=0.002)
+    assert (spoken / "lab.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert np.nanmax(np.abs(rec.volume_change)) <= 0.003
+    # the jaw opens for each /a/ (JO 2.5 N) and closes between them
+    jaw = rec.control_points["jaw"][:, 1]
+    t = rec.time_s
+    assert jaw[np.searchsorted(t, 0.19)] < jaw[0] - 0.2 and jaw[np.searchsorted(t, 0.29)] > jaw[np.searchsorted(t, 0.19)]
+    # the TextGrid: one interval per segment, read by praatio (and by Praat when the test extra is there)
+    from praatio import textgrid
+
+    tg = textgrid.openTextgrid(str(spoken / "lab.TextGrid"), includeEmptyIntervals=False)
+    tier = tg.getTier("segments")
+    assert [e.label for e in tier.entries] == rec.labels
+    assert [round(e.start, 6) for e in tier.entries] == pytest.approx(rec.starts_s.tolist())
+    parselmouth = pytest.importorskip("parselmouth")
+    grid = parselmouth.read(str(spoken / "lab.TextGrid"))
+    assert parselmouth.praat.call(grid, "Get number of intervals", 1) == 5
+    # a second run finds everything up to date
+    res = _run("speak", spoken / "lab.yaml", "--mesh", mesh_file, "--out", spoken / "lab.wav")
+    assert res.exit_code == 0 and "up to date" in res.output
+
+
+def test_a_closure_is_silent_and_its_release_makes_a_burst(spoken):
+    rec = speak.read(spoken / "lab.h5")
+    y, rate = read_wav(spoken / "lab.wav")
+    m = speak.measures(rec, y, rate)
+    (c, *_) = m["closures"]
+    assert 60 <= c["duration_ms"] <= 110 and c["start_s"] == pytest.approx(0.21, abs=0.01)
+    vowel_db = np.mean([s["level_db"] for s in m["segments"] if s["label"] == "a"])
+    assert c["level_db"] < vowel_db - 30
+    # the release: noise above 3 kHz in its first 15 ms, far above the closure's
+    burst = band_level_db(y, rate, c["end_s"], c["end_s"] + 0.015, 3000.0)
+    assert burst > band_level_db(y, rate, c["start_s"] + 0.01, c["end_s"] - 0.01, 3000.0) + 40
+    assert np.all(np.isnan(rec.formants_hz[(rec.time_s > c["start_s"] + 0.01) & (rec.time_s < c["end_s"] - 0.01)]))
+
+
+def test_a_narrow_channel_makes_frication_that_the_noise_switch_removes(spoken, mesh_file, tmp_path):
+    rec = speak.read(spoken / "lab.h5")
+    y, rate = read_wav(spoken / "lab.wav")
+    seg = {s["label"]: s for s in speak.measures(rec, y, rate)["segments"]}
+    fric = band_level_db(y, rate, 0.49, 0.58, 3000.0)
+    d = yaml.safe_load((ROOT / "configs" / "default.yaml").read_text())
+    d["speech"] = {"noise": {"enabled": False}}
+    cfg = _write(tmp_path / "quiet.yaml", d)
+    res = _run("speak", spoken / "lab.yaml", "--mesh", mesh_file, "--config", cfg, "--out", tmp_path / "quiet.wav")
+    assert res.exit_code == 0, res.output
+    q, _ = read_wav(tmp_path / "quiet.wav")
+    # both files are normalised to the same peak (the vowels): the noise is what the switch removed
+    assert fric > band_level_db(q, rate, 0.49, 0.58, 3000.0) + 20
+    assert seg["f"]["level_above_3khz_db"] > seg["a"]["level_above_3khz_db"]
