@@ -388,7 +388,8 @@ class Speech(Strict):
     glottal_area_voiced_cm2: Annotated[float, Field(gt=0, le=2, allow_inf_nan=False)] = 0.05  # its mean while voicing (mean flow about 180 cm^3/s)
     glottal_area_voiceless_cm2: Annotated[float, Field(gt=0, le=2, allow_inf_nan=False)] = 0.3  # abducted
     glottal_flow_peak_cm3_s: Annotated[float, Field(gt=0, le=2000, allow_inf_nan=False)] = 300.0  # the voice's AC flow
-    frame_ms: Annotated[float, Field(gt=0, le=50, allow_inf_nan=False)] = 5.0  # tract and formant frames
+    frame_ms: Annotated[float, Field(gt=0, le=50, allow_inf_nan=False)] = 5.0  # tract frames (the sound's)
+    formant_frame_ms: Annotated[float, Field(gt=0, le=50, allow_inf_nan=False)] = 10.0  # formant tracks, between: linear
     noise: Noise = Noise()
 
 

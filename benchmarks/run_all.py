@@ -19,7 +19,8 @@ HERE = Path(__file__).resolve().parent
 BENCHES = [("Tongue alone (section II)", "bench_tissue.py"), ("Whole articulator (section III)", "bench_articulator.py"),
            ("EP maps (section IV.B)", "bench_epmap.py"), ("Target solver (section V)", "bench_solver.py"),
            ("Acoustics (tubes)", "bench_acoustics.py"), ("Vocal tract (area functions)", "bench_vocal_tract.py"),
-           ("Vowels (acoustic maps, formant targets)", "bench_vowels.py")]
+           ("Vowels (acoustic maps, formant targets)", "bench_vowels.py"),
+           ("Utterances (simulation and sound of 1 s of speech)", "bench_speak.py")]
 
 
 def main() -> int:

@@ -14,6 +14,7 @@ freshness record and is written last.
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
@@ -75,6 +76,7 @@ class Spoken:
     control_points: dict[str, np.ndarray]  # (F, 3) cm
     muscle_names: list[str]
     muscle_force_n: np.ndarray  # (F, M) commanded
+    timings_s: dict[str, float]  # wall time of each part: rest, simulation, tract, formants, sound
 
 
 # --- the plan: targets -> forces ---------------------------------------------------------------------
@@ -221,12 +223,22 @@ def compute(u: Utterance, p: Plan, cfg: Config, mesh, wall, progress=None, model
     ramp_s = units.ms_to_s(sp.ramp_ms if u.ramp_ms is None else u.ramp_ms)
     force_at = course(p.starts_s, vectors, ramp_s)
     zero = np.zeros((model.n_nodes, 3))
+    clock = [time.perf_counter()]
+    timings: dict[str, float] = {}
+
+    def lap(name: str) -> None:
+        now = time.perf_counter()
+        timings[name] = now - clock[0]
+        clock[0] = now
+
     start = settle(model)
+    lap("rest posture")
     duration = float(p.starts_s[-1] + p.durations_s[-1])
     dt = units.ms_to_s(view.simulation.dt_ms)
     every = max(1, int(round(units.ms_to_s(sp.frame_ms) / dt)))
     traj, _ = run(model, start, lambda t: Control(node_force=zero, muscle_force=force_at(t)), duration, dt,
                   record_every=every, progress=progress, keep_partial=True)
+    lap("simulation")
     bad = sim_stage.problems(traj, model.volume_constraint)
     if bad:
         raise NotPhysical(f"utterance '{u.name}': the simulation is not physical ({'; '.join(bad)}); nothing written")
@@ -239,10 +251,17 @@ def compute(u: Utterance, p: Plan, cfg: Config, mesh, wall, progress=None, model
                for k, (s, (a, l), port) in enumerate(zip(p.starts_s, p.lips, p.ports))]
     controls = vt_stage.controls_for(vtc, traj.time, entries + list(u.tract))
     tracts = vt_stage.compute(vtc, cfg.speaker.wall, shapes, controls)
-    tubes = [Tube(tracts.af.length_cm[k], tracts.af.area_cm2[k]) for k in range(tracts.n_frames)]
-    ac = ac_stage.compute(tubes, cfg, velum_area_cm2=controls["velum_port_cm2"],
-                          port_from_glottis_cm=ac_stage.port_positions(tracts))
-    formants_hz = np.where((tracts.af.area_cm2.min(axis=1) > 0)[:, None], ac.formants_hz, np.nan)  # closed: none
+    lap("tract")
+    # formant tracks on a coarser grid of frames (the last one always), linear between
+    stride = max(1, int(round(sp.formant_frame_ms / sp.frame_ms)))
+    picked = np.unique(np.r_[np.arange(0, tracts.n_frames, stride), tracts.n_frames - 1])
+    tubes = [Tube(tracts.af.length_cm[k], tracts.af.area_cm2[k]) for k in picked]
+    ac = ac_stage.compute(tubes, cfg, velum_area_cm2=controls["velum_port_cm2"][picked],
+                          port_from_glottis_cm=ac_stage.port_positions(tracts)[picked])
+    formants_hz = np.stack([np.interp(traj.time, traj.time[picked], ac.formants_hz[:, j])
+                            for j in range(ac.formants_hz.shape[1])], axis=1)
+    formants_hz[tracts.af.area_cm2.min(axis=1) <= 0] = np.nan  # a closed tract has none
+    lap("formant tracks")
     # the glottis and the air: voiced segments adduct it, voiceless ones open it
     voiced = p.voiced.astype(float)
     v_ramp = units.ms_to_s(sp.voicing_ramp_ms)
@@ -259,11 +278,12 @@ def compute(u: Utterance, p: Plan, cfg: Config, mesh, wall, progress=None, model
                                      contour=[(float(a), float(b)) for a, b in u.f0_hz] if len(u.f0_hz) > 1 else None,
                                      f0_hz=float(u.f0_hz[0][1]), amplitude=amplitude,
                                      flow_peak_cm3_s=sp.glottal_flow_peak_cm3_s, noise=noise)
+    lap("sound")
     cps = {name: traj.x[:, idx] for name, idx in model.control_points().items()}
     commanded = np.array([force_at(float(t)) for t in traj.time])
     return Spoken(utterance=u, plan=p, trajectory=traj, tracts=tracts, formants_hz=formants_hz, noise=tb,
                   glottis_cm2=glottis, audio=audio, control_points=cps, muscle_names=list(model.muscle_names),
-                  muscle_force_n=units.dyn_to_newton(commanded))
+                  muscle_force_n=units.dyn_to_newton(commanded), timings_s=timings)
 
 
 # --- files ---------------------------------------------------------------------------------------------

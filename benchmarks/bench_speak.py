@@ -1,0 +1,48 @@
+"""Speed of speaking an utterance once its targets are solved (issue "Utterances").
+
+Goal: simulation plus synthesis of 1 s of speech at most 10 s of wall time on one core.  A 1-s utterance of
+four force sets (/a/, /i/-like, a lip closure, /a/) on the default speaker; prints each part's time: the
+rest posture, the simulation (contact on), the tract and formant tracks, the sound.  Needs only the config.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")  # one core, as the goal says
+os.environ.setdefault("NUMBA_NUM_THREADS", "1")
+
+from artic_cli.config import load_config  # noqa: E402
+from artic_cli.geometry.mesh import tongue_mesh  # noqa: E402
+from artic_cli.geometry.wall import wall_surface  # noqa: E402
+from artic_cli.stages import speak  # noqa: E402
+from artic_cli.utterance import parse_utterance  # noqa: E402
+
+UTTERANCE = {"name": "bench", "f0_hz": [[0.0, 125], [1.0, 100]],
+             "segments": [{"forces_n": {"JO": 2.5, "HG": 1.0}, "duration_ms": 300, "label": "a"},
+                          {"forces_n": {"JO": 0.5, "GGp": 4.0, "SL": 1.0}, "duration_ms": 250, "label": "i"},
+                          {"forces_n": {"JO": 0.5}, "duration_ms": 150, "label": "p", "voiced": False},
+                          {"forces_n": {"JO": 2.5, "HG": 1.0}, "duration_ms": 300, "label": "a"}],
+             "tract": [{"at_ms": 550, "ramp_ms": 15, "lip_area_cm2": 0.0}, {"at_ms": 700, "ramp_ms": 10,
+                                                                             "lip_area_cm2": 3.0}]}
+
+
+def main() -> None:
+    cfg = load_config()
+    mesh, wall = tongue_mesh(cfg.speaker.tongue), wall_surface(cfg.speaker.wall)
+    u = parse_utterance(UTTERANCE, "bench")
+    p = speak.plan(u, cfg)
+    model = speak.sim_stage.build(cfg, mesh, wall)
+    t0 = time.perf_counter()
+    s = speak.compute(u, p, cfg, mesh, wall, model=model)
+    total = time.perf_counter() - t0
+    st = s.trajectory.stats
+    print(f"speak 1.0 s (4 force sets, a lip closure): {total:.1f} s wall on one core, of which the simulation "
+          f"{st['wall_time_s']:.1f} s ({st['steps']} steps, {st['newton_iterations']} Newton iterations) "
+          f"(goal <= 10 s) -> {'met' if total <= 10.0 else 'NOT MET'}")
+    print("  " + "; ".join(f"{name} {t_:.2f} s" for name, t_ in s.timings_s.items()))
+
+
+if __name__ == "__main__":
+    main()
