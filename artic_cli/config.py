@@ -388,6 +388,13 @@ class Speech(Strict):
     glottal_area_voiced_cm2: Annotated[float, Field(gt=0, le=2, allow_inf_nan=False)] = 0.05  # its mean while voicing (mean flow about 180 cm^3/s)
     glottal_area_voiceless_cm2: Annotated[float, Field(gt=0, le=2, allow_inf_nan=False)] = 0.3  # abducted
     glottal_flow_peak_cm3_s: Annotated[float, Field(gt=0, le=2000, allow_inf_nan=False)] = 300.0  # the voice's AC flow
+    # the paper's controller holds each target's forces ("static"); "pulse_step" opens each segment with a
+    # pulse of F + pulse_gain (F - F_before) for pulse_ms (beyond the paper: reaching the target in time)
+    force_course: Literal["static", "pulse_step"] = "static"
+    pulse_ms: Annotated[float, Field(gt=0, le=200, allow_inf_nan=False)] = 40.0
+    pulse_gain: Annotated[float, Field(ge=0, le=5, allow_inf_nan=False)] = 1.0
+    reach_hold_ms: Annotated[float, Field(ge=0, le=2000, allow_inf_nan=False)] = 400.0  # each set held this long
+    # from rest gives its EP, the place the segment heads for (0: not measured)
     frame_ms: Annotated[float, Field(gt=0, le=50, allow_inf_nan=False)] = 5.0  # tract frames (the sound's)
     formant_frame_ms: Annotated[float, Field(gt=0, le=50, allow_inf_nan=False)] = 10.0  # formant tracks, between: linear
     noise: Noise = Noise()

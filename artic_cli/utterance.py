@@ -5,6 +5,7 @@ Example::
     name: aka
     f0_hz: [[0.0, 125], [0.6, 100]]      # [time_s, F0 Hz] points, times rising; between them linear
     ramp_ms: 30                          # optional: each target's forces ramp in over this (config speech.ramp_ms)
+    force_course: static                 # optional: or pulse_step (config speech.force_course)
     segments:
       - {target: configs/targets/vowels/a.yaml, duration_ms: 250}
       - {target: configs/targets/consonants/k.yaml, duration_ms: 80, voiced: false}
@@ -20,7 +21,7 @@ A target path is read relative to the working folder, else to the utterance file
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Literal
 
 from pydantic import Field, field_validator, model_validator
 
@@ -52,6 +53,7 @@ class Utterance(Strict):
     f0_hz: list[Annotated[list[Annotated[float, Field(allow_inf_nan=False)]], Field(min_length=2, max_length=2)]] = \
         [[0.0, 120.0]]
     ramp_ms: Annotated[float, Field(ge=0, le=500, allow_inf_nan=False)] | None = None
+    force_course: Literal["static", "pulse_step"] | None = None  # the config's speech.force_course otherwise
     tract: list[TractEntry] = []
 
     @field_validator("f0_hz")

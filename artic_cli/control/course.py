@@ -38,3 +38,18 @@ def course(starts_s, vectors, ramp_s: float, initial=None):
         return base[k] + (v[k] - base[k]) * w
 
     return at
+
+
+def pulse_step(starts_s, durations_s, vectors, pulse_s: float, gain: float, upper: float):
+    """The sets of a pulse-step course (beyond the paper): each segment opens with a pulse of
+    ``F_k + gain (F_k - F_k-1)`` (clipped to 0..``upper``) for ``pulse_s`` (at most half the segment), then
+    holds F_k; returns the starts and vectors to give :func:`course`."""
+    v = np.asarray(vectors, float)
+    starts, sets = [], []
+    before = np.zeros(v.shape[1])
+    for t0, d, f in zip(np.asarray(starts_s, float), np.asarray(durations_s, float), v):
+        width = min(pulse_s, 0.5 * d)
+        starts += [t0, t0 + width]
+        sets += [np.clip(f + gain * (f - before), 0.0, upper), f]
+        before = f
+    return np.array(starts), np.array(sets)

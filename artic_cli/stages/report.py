@@ -433,10 +433,21 @@ def utterance_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row
             hf = s_[0]["level_above_3khz_db"] - float(np.mean([s["level_above_3khz_db"] for s in vowels])) if s_ else np.nan
             rows.append(Row("/asa/: level above 3 kHz, /s/ against the vowels", ">= +20 dB (goal)", f"{hf:+.1f} dB",
                             _verdict(bool(hf >= 20), "frication")))
+        if name.startswith("aia"):
+            t90 = "; ".join(f"{s['label']} " + " / ".join(f"{s.get(f'{c}_t90_ms', np.nan):.0f}" for c in
+                                                           ("tip", "dorsum", "jaw")) for s in m["segments"])
+            lines.append(f"  * {m['force_course']} forces: time to cover 90 % of the way to each segment's EP "
+                         f"(tip / dorsum / jaw, ms): {t90}; commanded force impulse {m['force_impulse_n_s']:.2f} "
+                         f"N s, peak total {m['peak_total_force_n']:.1f} N")
         fast = {k: sp.get(k, np.nan) for k in EMA_PEAK_CM_S}
         ok = all(fast[k] <= 1.5 * v for k, v in EMA_PEAK_CM_S.items())
         rows.append(Row(f"/{name}/: peak speeds tip / dorsum / jaw", "<= 40 / 32 / 12 cm/s (EMA, Table II) +50 %",
-                        " / ".join(f"{fast[k]:.1f}" for k in EMA_PEAK_CM_S) + " cm/s", _verdict(ok, "within")))
+                        " / ".join(f"{fast[k]:.1f}" for k in EMA_PEAK_CM_S) + " cm/s",
+                        _verdict(ok, "each at most 50 % above the EMA peak")))
+        rows.append(Row(f"/{name}/: volume change, inverted bricks", "<= 0.3 %, none (goal)",
+                        f"{100 * m['max_volume_change']:.3f} %, {int(rec.attrs.get('inverted_bricks_max', 0))}",
+                        _verdict(m["max_volume_change"] <= 0.003 and int(rec.attrs.get("inverted_bricks_max", 0)) == 0,
+                                 "the tissue stays physical")))
     return rows, lines + [""] + pictures + [""]
 
 

@@ -25,7 +25,7 @@ from .. import units
 from ..acoustics.aerodynamics import turbulence
 from ..acoustics.tube import Tube
 from ..config import Config, load_config
-from ..control.course import course, raised_cosine
+from ..control.course import course, pulse_step
 from ..control.solver import TargetSpec, parse_target
 from ..errors import ArticError, NotPhysical, UnreachableTarget
 from ..io.fingerprint import digest
@@ -77,6 +77,8 @@ class Spoken:
     muscle_names: list[str]
     muscle_force_n: np.ndarray  # (F, M) commanded
     timings_s: dict[str, float]  # wall time of each part: rest, simulation, tract, formants, sound
+    segment_eps_cm: np.ndarray  # (K, 3, 3) tip, dorsum, jaw where each segment's forces lead (held from rest)
+    force_course: str  # static or pulse_step
 
 
 # --- the plan: targets -> forces ---------------------------------------------------------------------
@@ -188,7 +190,7 @@ def _solve(t: TargetSpec, k: int, ctx, sim, voicer, cfg, config, folder: Path, m
         forces, _, which = solution_forces(doc)
         if say:
             say(f"segment {k} ({t.name}): unreachable, speaking the nearest answer ({which})")
-        return forces, f"nearest ({which})", path
+        return forces, "unreachable: nearest answer", path
     forces, reached, which = solution_forces(doc)
     if not reached:
         if not accept_nearest:
@@ -196,11 +198,29 @@ def _solve(t: TargetSpec, k: int, ctx, sim, voicer, cfg, config, folder: Path, m
                                     "give --accept-nearest to speak the best answer found")
         if say:
             say(f"segment {k} ({t.name}): refinement did not reach the tolerance; speaking its best answer")
-        return forces, f"best, not within tolerance ({which})", path
-    return forces, f"solved ({which})", path
+        return forces, "refined, not within tolerance", path
+    return forces, "solved" + (", refined" if which == "refined" else ""), path
 
 
 # --- the run: forces -> movement -> tract -> sound -------------------------------------------------------
+
+def equilibria(model, rest, vectors: np.ndarray, hold_s: float, dt_s: float) -> np.ndarray:
+    """(K, 3, 3) tip, dorsum and jaw (cm) after holding each segment's forces ``hold_s`` from the rest posture
+    with the jaw free: where its static forces take the articulators (NaN when ``hold_s`` is 0)."""
+    out = np.full((len(vectors), 3, 3), np.nan)
+    if hold_s <= 0:
+        return out
+    pts = model.control_points()
+    zero = np.zeros((model.n_nodes, 3))
+    seen: dict[bytes, np.ndarray] = {}
+    for k, v in enumerate(vectors):
+        key = np.round(v, 6).tobytes()
+        if key not in seen:
+            _, end = run(model, rest, lambda t, v=v: Control(node_force=zero, muscle_force=v), hold_s, dt_s)
+            seen[key] = np.array([end.x[pts[n]] for n in ("tip", "dorsum", "jaw")])
+        out[k] = seen[key]
+    return out
+
 
 def ramp_weights(starts_s: np.ndarray, values: np.ndarray, ramp_s: float, t: np.ndarray) -> np.ndarray:
     """A per-segment value (K,) at times ``t``, moving to each segment's value over ``ramp_s`` from its start."""
@@ -221,7 +241,12 @@ def compute(u: Utterance, p: Plan, cfg: Config, mesh, wall, progress=None, model
             raise ArticError(f"segment {k}: muscle '{bad[0]}' is unknown; valid: {', '.join(names)}")
     vectors = np.array([muscle_force_vector(model, f) for f in p.forces_n])
     ramp_s = units.ms_to_s(sp.ramp_ms if u.ramp_ms is None else u.ramp_ms)
-    force_at = course(p.starts_s, vectors, ramp_s)
+    how = sp.force_course if u.force_course is None else u.force_course
+    starts, sets = p.starts_s, vectors
+    if how == "pulse_step":
+        starts, sets = pulse_step(p.starts_s, p.durations_s, vectors, units.ms_to_s(sp.pulse_ms), sp.pulse_gain,
+                                  units.newton_to_dyn(view.muscles.max_force_n))
+    force_at = course(starts, sets, ramp_s)
     zero = np.zeros((model.n_nodes, 3))
     clock = [time.perf_counter()]
     timings: dict[str, float] = {}
@@ -233,6 +258,8 @@ def compute(u: Utterance, p: Plan, cfg: Config, mesh, wall, progress=None, model
 
     start = settle(model)
     lap("rest posture")
+    eps = equilibria(model, start, vectors, units.ms_to_s(sp.reach_hold_ms), units.ms_to_s(view.simulation.dt_ms))
+    lap("segment EPs")
     duration = float(p.starts_s[-1] + p.durations_s[-1])
     dt = units.ms_to_s(view.simulation.dt_ms)
     every = max(1, int(round(units.ms_to_s(sp.frame_ms) / dt)))
@@ -283,7 +310,8 @@ def compute(u: Utterance, p: Plan, cfg: Config, mesh, wall, progress=None, model
     commanded = np.array([force_at(float(t)) for t in traj.time])
     return Spoken(utterance=u, plan=p, trajectory=traj, tracts=tracts, formants_hz=formants_hz, noise=tb,
                   glottis_cm2=glottis, audio=audio, control_points=cps, muscle_names=list(model.muscle_names),
-                  muscle_force_n=units.dyn_to_newton(commanded), timings_s=timings)
+                  muscle_force_n=units.dyn_to_newton(commanded), timings_s=timings, segment_eps_cm=eps,
+                  force_course=how)
 
 
 # --- files ---------------------------------------------------------------------------------------------
@@ -328,6 +356,9 @@ def write(wav: Path | str, s: Spoken, prov=None) -> dict[str, Path]:
         g.create_dataset("voiced", data=p.voiced)
         g.create_dataset("how", data=np.array(p.notes, dtype="S"))
         g.create_dataset("solution", data=np.array(p.solutions, dtype="S"))
+        g.create_dataset("ep", data=s.segment_eps_cm).attrs["units"] = ("cm: tip, dorsum, jaw where each segment's "
+                                                                        "forces lead (held from rest, jaw free)")
+        g.attrs["force_course"] = s.force_course
         g.create_dataset("lip_area", data=np.array([a for a, _ in p.lips])).attrs["units"] = "cm^2"
         g.create_dataset("lip_length", data=np.array([b for _, b in p.lips])).attrs["units"] = "cm"
         names = sorted({m for f_ in p.forces_n for m in f_})
@@ -383,6 +414,9 @@ class Record:
     noise_rms: np.ndarray
     positions_cm: np.ndarray
     volume_change: np.ndarray
+    eps_cm: np.ndarray  # (K, 3, 3)
+    commanded_n: np.ndarray  # (F, M)
+    force_course: str
 
 
 def read(path: Path | str) -> Record:
@@ -395,7 +429,9 @@ def read(path: Path | str) -> Record:
                           time_s=f["time"][()], control_points={k: v[()] for k, v in f["control_points"].items()},
                           formants_hz=f["formants"][()], area_cm2=f["area_function/area"][()],
                           length_cm=f["area_function/length"][()], noise_rms=f["aerodynamics/noise_rms"][()],
-                          positions_cm=f["positions"][()], volume_change=f["volume_change"][()])
+                          positions_cm=f["positions"][()], volume_change=f["volume_change"][()],
+                          eps_cm=g["ep"][()], commanded_n=f["muscles/commanded"][()],
+                          force_course=str(g.attrs.get("force_course", "static")))
         except (KeyError, ValueError, OSError) as err:
             raise ArticError(f"{path} is damaged or incomplete ({type(err).__name__}); {STAGE.hint}") from None
 
@@ -444,8 +480,10 @@ def speak(utterance: Path | str, out: Path | str | None = None, maps: Path | str
 # --- what an utterance did, measured ---------------------------------------------------------------------
 
 def measures(rec: Record, samples: np.ndarray, rate_hz: int) -> dict:
-    """Per segment: median F1/F2 of our tracks over its middle half, its level (dB) overall and above 3 kHz;
-    the closures (frames with a zero area) and their level; peak speeds of the control points (cm/s)."""
+    """Per segment: median F1/F2 of our tracks over its middle half, its level (dB) overall and above 3 kHz,
+    and for tip, dorsum and jaw how far they still are from the segment's EP at its end (cm), the fraction of
+    the way covered, and the time to cover 90 % of it (ms); the closures (frames with a zero area) and their
+    level; peak speeds of the control points (cm/s); the commanded force's impulse (N s) and peak (N)."""
     from ..acoustics.measures import band_level_db, runs
 
     t = rec.time_s
@@ -466,6 +504,24 @@ def measures(rec: Record, samples: np.ndarray, rate_hz: int) -> dict:
     dt = np.diff(t)
     speeds = {name: float(np.max(np.linalg.norm(np.diff(xyz[:, :2], axis=0), axis=1) / dt)) if len(dt) else 0.0
               for name, xyz in rec.control_points.items()}
-    return {"segments": segs, "closures": closures, "peak_speed_cm_s": speeds,
+    cps = ("tip", "dorsum", "jaw")
+    for k, seg in enumerate(segs):  # how far each control point still is from where the segment's forces lead
+        end = min(np.searchsorted(t, seg["start_s"] + seg["duration_s"] - 1e-9), len(t) - 1)
+        begin = np.searchsorted(t, seg["start_s"])
+        for j, name in enumerate(cps):
+            if name in rec.control_points and np.isfinite(rec.eps_cm[k, j]).all():
+                ep = rec.eps_cm[k, j, :2]
+                left = float(np.linalg.norm(rec.control_points[name][end, :2] - ep))
+                away = float(np.linalg.norm(rec.control_points[name][begin, :2] - ep))
+                seg[f"{name}_left_cm"] = left
+                seg[f"{name}_reached"] = 1.0 - left / away if away > 1e-3 else 1.0
+                # the time it takes to cover 90 % of the way (NaN: not within the segment)
+                path = np.linalg.norm(rec.control_points[name][begin:end + 1, :2] - ep, axis=1)
+                hit = np.flatnonzero(path <= 0.1 * away)
+                seg[f"{name}_t90_ms"] = float(1e3 * (t[begin + hit[0]] - seg["start_s"])) if len(hit) else float("nan")
+    total = rec.commanded_n.sum(axis=1)
+    impulse = float(np.sum(0.5 * (total[1:] + total[:-1]) * dt)) if len(dt) else 0.0
+    return {"segments": segs, "closures": closures, "peak_speed_cm_s": speeds, "force_impulse_n_s": impulse,
+            "peak_total_force_n": float(total.max()) if len(total) else 0.0, "force_course": rec.force_course,
             "max_volume_change": float(np.nanmax(np.abs(rec.volume_change))),
             "min_constriction_cm2": float(rec.area_cm2.min())}

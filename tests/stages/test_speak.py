@@ -153,3 +153,11 @@ def test_a_narrow_channel_makes_frication_that_the_noise_switch_removes(spoken, 
     # both files are normalised to the same peak (the vowels): the noise is what the switch removed
     assert fric > band_level_db(q, rate, 0.49, 0.58, 3000.0) + 20
     assert seg["f"]["level_above_3khz_db"] > seg["a"]["level_above_3khz_db"]
+
+
+def test_a_pulse_step_course_opens_each_segment_with_a_clipped_pulse():
+    from artic_cli.control.course import pulse_step
+
+    starts, sets = pulse_step([0.0, 0.2], [0.2, 0.05], np.array([[4.0, 0.0], [1.0, 3.0]]), 0.04, 1.0, 6.0)
+    assert starts.tolist() == pytest.approx([0.0, 0.04, 0.2, 0.225])  # the second pulse: half its 50-ms segment
+    assert sets.tolist() == [[6.0, 0.0], [4.0, 0.0], [0.0, 6.0], [1.0, 3.0]]  # 4 + 4 capped at 6; 1 - 3 at 0
