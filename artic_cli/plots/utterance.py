@@ -48,7 +48,7 @@ def plot_utterance(record, samples: np.ndarray, sample_rate_hz: int, path: Path 
     return save_figure(fig, path)
 
 
-def animate_utterance(record, model, wall, path: Path | str, fps: int = 20, max_frames: int = 120) -> Path:
+def animate_utterance(record, model, wall, path: Path | str, fps: int = 20, max_frames: int = 100) -> Path:
     """The midsagittal tongue, jaw and wall moving through the utterance (a GIF); ``model``: the articulator
     the record was simulated with."""
     from types import SimpleNamespace

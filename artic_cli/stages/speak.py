@@ -29,7 +29,7 @@ from ..control.course import course, pulse_step
 from ..control.solver import TargetSpec, parse_target
 from ..errors import ArticError, NotPhysical, UnreachableTarget
 from ..io.fingerprint import digest
-from ..io.store import atomic_h5, atomic_path, open_artifact
+from ..io.store import atomic_h5, atomic_path, open_artifact, stored_content_hash
 from ..mechanics.loads import muscle_force_vector
 from ..mechanics.model import ARTICULATOR_SECTIONS, Control
 from ..mechanics.simulate import Trajectory, run, settle
@@ -125,9 +125,9 @@ def plan(u: Utterance, cfg: Config, source: Path | str | None = None, maps: Path
          mesh: Path | str = "data/mesh.h5", acoustic_maps: Path | str | None = "data/acoustic_maps.h5",
          config: Path | str | None = None, solutions: Path | str = "data/utterances/solutions",
          accept_nearest: bool = False, budget: int = 8,
-         say: Callable[[str], None] | None = None) -> Plan:
+         say: Callable[[str], None] | None = None, targets: list[TargetSpec | None] | None = None) -> Plan:
     """Solve every segment's target (cached) and collect the forces, lips and voicing of each segment."""
-    targets = _targets(u, source, cfg.muscles.max_force_n)
+    targets = _targets(u, source, cfg.muscles.max_force_n) if targets is None else targets
     vt = vt_stage.speaker_tract(cfg)
     default_lips = (float(vt.lips.area_cm2), float(vt.lips.length_cm))
     ctx = sim = voicer = None
@@ -463,16 +463,22 @@ def speak(utterance: Path | str, out: Path | str | None = None, maps: Path | str
     cfg = load_config(config)
     out = _check_out(out if out is not None else Path("data/utterances") / f"{u.name}.wav")
     m = mesh_stage.read(mesh, cfg)
-    model = sim_stage.build(cfg, m.mesh, m.wall)
-    check_forces(u, list(model.drivable()), str(utterance))
     folder = Path(solutions) if solutions is not None else out.parent / "solutions"
-    p = plan(u, cfg, utterance, maps, mesh, acoustic_maps, config, folder, accept_nearest, budget, say)
-    prov = STAGE.provenance(cfg, inputs={"mesh": m.content_sha256, "utterance": digest(u.model_dump(mode="json")),
-                                         "plan": digest({"forces": p.forces_n, "lips": p.lips, "ports": p.ports,
-                                                         "voiced": p.voiced.tolist(), "labels": p.labels})})
+    targets = _targets(u, utterance, cfg.muscles.max_force_n)
+    # the recipe: what the targets are solved on and with, so an unchanged utterance is known without solving
+    inputs = {"mesh": m.content_sha256, "utterance": digest(u.model_dump(mode="json")),
+              "targets": [None if t is None else digest(t.model_dump(mode="json")) for t in targets]}
+    if any(t is not None for t in targets):
+        inputs["epmaps"] = stored_content_hash(maps) or ""
+        if any(t is not None and t.acoustic is not None for t in targets):
+            inputs["acoustic_maps"] = (stored_content_hash(acoustic_maps) or "") if acoustic_maps is not None else ""
+    prov = STAGE.provenance(cfg, inputs=inputs, params={"accept_nearest": accept_nearest, "budget": budget})
     paths = {"wav": out, "textgrid": textgrid_path(out), "h5": h5_path(out)}
     if up_to_date(paths["h5"], prov) and paths["wav"].is_file() and paths["textgrid"].is_file():
         return SpeakResult(paths, None, up_to_date=True)
+    model = sim_stage.build(cfg, m.mesh, m.wall)
+    check_forces(u, list(model.drivable()), str(utterance))
+    p = plan(u, cfg, utterance, maps, mesh, acoustic_maps, config, folder, accept_nearest, budget, say, targets)
     s = compute(u, p, cfg, m.mesh, m.wall, progress, model)
     return SpeakResult(write(out, s, prov), s)
 

@@ -203,7 +203,9 @@ def test_an_interrupted_build_resumes_from_the_finished_equilibria(tmp_path, mes
     import sys
     import time
 
-    cfg = _config(tmp_path, "resume", jaw_positions={"rest": {}}, typical_jaw="rest", muscles=["SL", "GGa", "V"],
+    # enough equilibria (6 muscles x 4 levels + the rest) that the interrupt lands while some are still to do
+    cfg = _config(tmp_path, "resume", jaw_positions={"rest": {}}, typical_jaw="rest",
+                  muscles=["SL", "GGa", "V", "T", "IL", "GGm"],
                   levels_n=[0.0, 0.5, 1.0, 2.0, 4.0], net_jaw_positions=[], pairs_tip=[], pairs_dorsum=[], groups=[])
     cache, out = tmp_path / "cache", tmp_path / "maps.h5"
     cmd = [sys.executable, "-m", "artic_cli.cli.main", "ep-map", "--mesh", str(mesh_file), "--config", cfg,
@@ -211,7 +213,7 @@ def test_an_interrupted_build_resumes_from_the_finished_equilibria(tmp_path, mes
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env, cwd=ROOT)
     deadline = time.time() + 120
-    while time.time() < deadline and len(list(cache.rglob("output.pkl"))) < 4:
+    while time.time() < deadline and len(list(cache.rglob("output.pkl"))) < 3:
         time.sleep(0.2)
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=60)
@@ -220,4 +222,5 @@ def test_an_interrupted_build_resumes_from_the_finished_equilibria(tmp_path, mes
     done = len(list(cache.rglob("output.pkl")))
     res = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=ROOT, timeout=300)
     assert res.returncode == 0, res.stderr
-    assert f"13 equilibria ({13 - done} computed, {done} from the cache)" in " ".join(res.stdout.split())
+    assert 3 <= done < 25
+    assert f"25 equilibria ({25 - done} computed, {done} from the cache)" in " ".join(res.stdout.split())

@@ -18,6 +18,9 @@ pytestmark = [pytest.mark.slow, pytest.mark.skipif(not (VENV / ".installed").exi
                                 reason="needs `make setup` (the pipeline runs the installed artic)")]
 
 
+PIPELINE = "PIPELINE=pipelines/ci.yaml"  # the paper pipeline with fewer utterances
+
+
 def make(*args, timeout=1200):
     return subprocess.run(["make", "--no-print-directory", *args], cwd=ROOT, capture_output=True, text=True,
                           timeout=timeout)
@@ -26,7 +29,8 @@ def make(*args, timeout=1200):
 @pytest.fixture(scope="module")
 def built(tmp_path_factory):
     out = tmp_path_factory.mktemp("pipeline")
-    res = make("-j2", "paper", "CONFIG=configs/ci_thin.yaml", f"OUT={out}")  # two stages at a time, as on 2 cores
+    # two stages at a time, as on 2 cores
+    res = make("-j2", "paper", "CONFIG=configs/ci_thin.yaml", PIPELINE, f"OUT={out}")
     assert res.returncode == 0, res.stdout[-3000:] + res.stderr[-3000:]
     return out
 
@@ -74,7 +78,7 @@ def _mtimes(out):
 
 def test_a_second_run_does_nothing(built):
     before = _mtimes(built)
-    res = make("paper", "CONFIG=configs/ci_thin.yaml", f"OUT={built}")
+    res = make("paper", "CONFIG=configs/ci_thin.yaml", PIPELINE, f"OUT={built}")
     assert res.returncode == 0, res.stdout + res.stderr
     assert "bin/artic" not in res.stdout and "bin/python" not in res.stdout, res.stdout  # no command runs
     assert _mtimes(built) == before
@@ -88,7 +92,7 @@ def test_a_plotting_edit_redraws_figures_and_recomputes_nothing(built):
     before = _mtimes(built)
     # -W: make sees a plotting module as just edited (a comment edit, as far as make can tell); the
     # tract figures are redrawn, every artefact is left alone
-    res = make("-j2", "paper", "CONFIG=configs/ci_thin.yaml", f"OUT={built}", "-W", "artic_cli/plots/vocal_tract.py")
+    res = make("-j2", "paper", "CONFIG=configs/ci_thin.yaml", PIPELINE, f"OUT={built}", "-W", "artic_cli/plots/vocal_tract.py")
     assert res.returncode == 0, res.stdout[-3000:] + res.stderr[-3000:]
     ran = [ln for ln in res.stdout.splitlines() if "bin/artic " in ln]
     assert any("artic plot " in ln for ln in ran) and any("artic report" in ln for ln in ran)
@@ -99,7 +103,7 @@ def test_a_plotting_edit_redraws_figures_and_recomputes_nothing(built):
 def test_a_touched_physics_module_reruns_stages_that_find_themselves_up_to_date(built):
     before = _mtimes(built)
     # the equilibrium code: make reruns the EP maps and what reads it, each finds its recipe unchanged
-    res = make("-j2", "paper", "CONFIG=configs/ci_thin.yaml", f"OUT={built}", "-W", "artic_cli/control/equilibrium.py")
+    res = make("-j2", "paper", "CONFIG=configs/ci_thin.yaml", PIPELINE, f"OUT={built}", "-W", "artic_cli/control/equilibrium.py")
     assert res.returncode == 0, res.stdout[-3000:] + res.stderr[-3000:]
     assert "artic ep-map" in res.stdout and "epmaps.h5 is up to date" in res.stdout
     assert "equilibria (" not in res.stdout  # no equilibrium computed, none even looked up
@@ -158,3 +162,12 @@ def test_the_tracts_of_the_pipeline_and_of_one_ep(built, tmp_path):
         vts.vocal_tract(ep="JO_9:SG=4", epmaps=built / "epmaps.h5", mesh=built / "mesh.h5", config=cfg,
                         out=tmp_path / "bad.h5")
     assert not (tmp_path / "bad.h5").exists()
+
+
+def test_the_ci_pipeline_is_the_paper_pipeline_with_fewer_utterances():
+    from artic_cli.pipeline import load_pipeline
+
+    paper, ci = load_pipeline(ROOT / "pipelines" / "paper.yaml"), load_pipeline(ROOT / "pipelines" / "ci.yaml")
+    drop = {"pipeline", "utterances"}
+    assert paper.model_dump(exclude=drop) == ci.model_dump(exclude=drop)
+    assert ci.utterances and set(ci.utterances) <= set(paper.utterances)

@@ -161,3 +161,27 @@ def test_a_pulse_step_course_opens_each_segment_with_a_clipped_pulse():
     starts, sets = pulse_step([0.0, 0.2], [0.2, 0.05], np.array([[4.0, 0.0], [1.0, 3.0]]), 0.04, 1.0, 6.0)
     assert starts.tolist() == pytest.approx([0.0, 0.04, 0.2, 0.225])  # the second pulse: half its 50-ms segment
     assert sets.tolist() == [[6.0, 0.0], [4.0, 0.0], [0.0, 6.0], [1.0, 3.0]]  # 4 + 4 capped at 6; 1 - 3 at 0
+
+
+def test_an_unreachable_target_exits_3_naming_its_segment_and_writes_nothing(tmp_path, mesh_file):
+    from artic_cli.stages.epmap import build_ep_maps
+
+    d = yaml.safe_load((ROOT / "configs" / "default.yaml").read_text())
+    d["epmap"] = dict(jaw_positions={"rest": {}}, typical_jaw="rest", net_jaw_positions=["rest"], muscles=["SL", "GGa"],
+                      levels_n=[0.0, 2.0], pair_levels_n=[2.0], pairs_tip=[["SL", "GGa"]], pairs_dorsum=[], groups=[])
+    cfg = _write(tmp_path / "cfg.yaml", d)
+    build_ep_maps(mesh_file, cfg, tmp_path / "maps.h5", jobs=1, cache=tmp_path / "cache")
+    far = {"name": "far", "jaw": {"forces_n": {}}, "crucial": {"point": "tip", "at_cm": [2.0, 3.0], "tolerance_cm": 0.05}}
+    u = _write(tmp_path / "u.yaml", {"name": "u", "segments": [dict(A, duration_ms=60), {"target": far, "duration_ms": 60}]})
+    args = ("speak", u, "--mesh", mesh_file, "--maps", tmp_path / "maps.h5", "--config", cfg,
+            "--out", tmp_path / "out" / "u.wav", "--solutions", tmp_path / "sol")
+    res = _run(*args)
+    assert res.exit_code == 3 and "segment 1" in res.output and "'far'" in res.output, res.output
+    assert "--accept-nearest" in res.output and not (tmp_path / "out").exists()
+    res = _run(*args, "--accept-nearest", "--animate", tmp_path / "u.gif")
+    assert res.exit_code == 0, res.output
+    from PIL import Image
+
+    assert Image.open(tmp_path / "u.gif").n_frames == 25  # every 5-ms frame of 120 ms, and the start
+    rec = speak.read(tmp_path / "out" / "u.h5")
+    assert rec.how == ["forces given", "unreachable: nearest answer"]
