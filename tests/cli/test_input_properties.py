@@ -200,3 +200,36 @@ def test_numeric_options_are_checked(value, mesh_file):
         ok = math.isfinite(value) and 1e-6 <= value <= 0.005
         assert res.exit_code == (0 if ok else 2), res.output
         assert (out / "s.h5").exists() == ok
+
+
+segment = st.fixed_dictionaries(
+    {"duration_ms": _maybe(numbers)},
+    optional={"forces_n": st.one_of(st.dictionaries(muscles, _maybe(numbers), max_size=3), anything),
+              "target": st.one_of(st.sampled_from(["configs/targets/velar.yaml", "nowhere.yaml"]), targets),
+              "voiced": _maybe(st.booleans()), "label": names})
+utterances = st.one_of(
+    st.fixed_dictionaries({"segments": st.one_of(st.lists(segment, max_size=3), anything)},
+                          optional={"name": names, "f0_hz": st.one_of(st.lists(st.lists(numbers, min_size=2, max_size=2),
+                                                                                max_size=3), anything),
+                                    "ramp_ms": _maybe(numbers), "force_course": _maybe(st.sampled_from(
+                                        ["static", "pulse_step", "jerk"])), "tract": st.lists(anything, max_size=2)}),
+    anything)
+
+
+@SETTINGS
+@given(utterance=utterances)
+def test_any_utterance_is_read_or_refused_in_one_line(utterance):
+    """Every utterance either reads as a valid one (durations positive, F0 50-500 Hz with rising times, one
+    source per segment) or is one ArticError naming its key; speaking the valid ones is tested elsewhere."""
+    from artic_cli.errors import ArticError
+    from artic_cli.utterance import parse_utterance
+
+    try:
+        u = parse_utterance(utterance, "u.yaml")
+    except ArticError as err:
+        assert "\n" not in str(err) and str(err).startswith("u.yaml")
+        return
+    assert u.segments and all(s.duration_ms > 0 for s in u.segments)
+    assert all(50 <= f <= 500 and t >= 0 for t, f in u.f0_hz)
+    assert all(b[0] > a[0] for a, b in zip(u.f0_hz, u.f0_hz[1:]))
+    assert all((s.target is None) != (s.forces_n is None) for s in u.segments)

@@ -84,14 +84,15 @@ LAB = {"name": "lab", "f0_hz": [[0.0, 125], [0.75, 100]],
        "segments": [dict(A, duration_ms=200), {"forces_n": {"JO": 0.5}, "duration_ms": 100, "label": "p",
                                                  "voiced": False},
                     dict(A), {"forces_n": {"JO": 0.5}, "duration_ms": 150, "label": "f", "voiced": False},
-                    dict(A)],
+                    dict(A), {"forces_n": {"JO": 0.5, "GGp": 4.0, "SL": 1.0}, "duration_ms": 250, "label": "i"}],
        "tract": [{"at_ms": 200, "ramp_ms": 15, "lip_area_cm2": 0.0}, {"at_ms": 300, "ramp_ms": 10, "lip_area_cm2": 3.0},
                  {"at_ms": 450, "ramp_ms": 20, "lip_area_cm2": 0.08}, {"at_ms": 600, "ramp_ms": 20, "lip_area_cm2": 3.0}]}
 
 
 @pytest.fixture(scope="module")
 def spoken(tmp_path_factory, mesh_file):
-    """/apa/ and a bilabial fricative between open-jaw vowels: the lips closed, then a narrow lip channel."""
+    """/apa/ and a bilabial fricative between open-jaw vowels (the lips closed, then a narrow lip channel), then
+an /i/-like front vowel (GGp 4 N, SL 1 N, the jaw nearly closed)."""
     tmp = tmp_path_factory.mktemp("speak")
     u = _write(tmp / "lab.yaml", LAB)
     res = _run("speak", u, "--mesh", mesh_file, "--out", tmp / "lab.wav", "--plot", tmp / "lab.png")
@@ -101,9 +102,9 @@ def spoken(tmp_path_factory, mesh_file):
 
 def test_a_spoken_sequence_writes_its_sound_textgrid_and_record(spoken, mesh_file):
     rec = speak.read(spoken / "lab.h5")
-    assert rec.labels == ["a", "p", "a", "f", "a"]
+    assert rec.labels == ["a", "p", "a", "f", "a", "i"]
     y, rate = read_wav(spoken / "lab.wav")
-    assert len(y) / rate == pytest.approx(0.75, abs=0.002)
+    assert len(y) / rate == pytest.approx(1.0, abs=0.002)
     assert (spoken / "lab.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert np.nanmax(np.abs(rec.volume_change)) <= 0.003
     # the jaw opens for each /a/ (JO 2.5 N) and closes between them
@@ -119,7 +120,7 @@ def test_a_spoken_sequence_writes_its_sound_textgrid_and_record(spoken, mesh_fil
     assert [round(e.start, 6) for e in tier.entries] == pytest.approx(rec.starts_s.tolist())
     parselmouth = pytest.importorskip("parselmouth")
     grid = parselmouth.read(str(spoken / "lab.TextGrid"))
-    assert parselmouth.praat.call(grid, "Get number of intervals", 1) == 5
+    assert parselmouth.praat.call(grid, "Get number of intervals", 1) == 6
     # a second run finds everything up to date
     res = _run("speak", spoken / "lab.yaml", "--mesh", mesh_file, "--out", spoken / "lab.wav")
     assert res.exit_code == 0 and "up to date" in res.output
@@ -185,3 +186,21 @@ def test_an_unreachable_target_exits_3_naming_its_segment_and_writes_nothing(tmp
     assert Image.open(tmp_path / "u.gif").n_frames == 25  # every 5-ms frame of 120 ms, and the start
     rec = speak.read(tmp_path / "out" / "u.h5")
     assert rec.how == ["forces given", "unreachable: nearest answer"]
+
+
+def test_praat_finds_our_formant_tracks_in_the_spoken_sound(spoken):
+    """The time-varying line carries the tracts' formants: Praat (Burg) on the WAV, mid-segment, against our
+    transfer function's tracks, for the open /a/ and the front vowel after it (F1 within 10 %, F2 within 7 %)."""
+    parselmouth = pytest.importorskip("parselmouth")
+    rec = speak.read(spoken / "lab.h5")
+    fm = parselmouth.Sound(str(spoken / "lab.wav")).to_formant_burg(0.01, 5, 5000, 0.025, 50)
+    for lab, (t0, t1) in (("a", (0.06, 0.18)), ("i", (0.85, 0.97))):
+        times = np.linspace(t0, t1, 9)
+        ours = [float(np.nanmedian(np.interp(times, rec.time_s, rec.formants_hz[:, k]))) for k in (0, 1)]
+        found = [np.nanmedian([fm.get_value_at_time(j, x) for x in times]) for j in range(1, 6)]
+        for k, tol in ((0, 0.10), (1, 0.07)):  # Burg may insert spurious peaks: take the one nearest ours
+            nearest = min(found, key=lambda v: abs(v - ours[k]))
+            assert abs(nearest / ours[k] - 1) < tol, (lab, k + 1, nearest, ours[k], found)
+    f2 = {lab: float(np.nanmedian(rec.formants_hz[(rec.time_s > s0 + 0.3 * d) & (rec.time_s < s0 + 0.8 * d), 1]))
+          for lab, s0, d in zip(rec.labels, rec.starts_s, rec.durations_s) if lab in ("a", "i")}
+    assert f2["i"] > f2["a"] + 50  # the front vowel's F2 above the open one's (measured: 1605 against 1506 Hz)
