@@ -843,6 +843,7 @@ def speak_cmd(
     accept_nearest: bool = typer.Option(False, "--accept-nearest", help="Speak the nearest reachable answer of an "
                                                                         "unreachable target instead of stopping."),
     budget: int = typer.Option(8, "--budget", help="Most simulations each target's refinement may spend."),
+    jobs: int = typer.Option(1, "--jobs", help="Processes solving distinct targets at once."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Spectrogram with formant tracks, segments and the "
                                                              "tip/dorsum/jaw heights (PNG)."),
     animate: Optional[Path] = typer.Option(None, "--animate", help="The midsagittal view moving (GIF)."),
@@ -852,12 +853,13 @@ def speak_cmd(
     from ..stages import speak as speak_stage
 
     check_number("--budget", budget, ge=1)
+    check_number("--jobs", jobs, ge=1)
     for opt, p, ext in (("--plot", plot, ".png"), ("--animate", animate, ".gif")):
         if p is not None and (p.suffix.lower() != ext or not p.parent.is_dir()):
             raise ArticError(f"{opt} {p}: give a {ext} file in an existing folder")
     say = lambda m: err_console.print(m, highlight=False)  # noqa: E731
     res = _with_progress("simulating", lambda update: speak_stage.speak(
-        utterance, out, maps, mesh, acoustic_maps, config, solutions, accept_nearest, budget, update, say))
+        utterance, out, maps, mesh, acoustic_maps, config, solutions, accept_nearest, budget, update, say, jobs))
     if res.up_to_date:
         out_console.print(f"{res.paths['wav']} is up to date (same utterance, solutions, mesh, config and code)",
                           highlight=False)

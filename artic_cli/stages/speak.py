@@ -125,21 +125,32 @@ def plan(u: Utterance, cfg: Config, source: Path | str | None = None, maps: Path
          mesh: Path | str = "data/mesh.h5", acoustic_maps: Path | str | None = "data/acoustic_maps.h5",
          config: Path | str | None = None, solutions: Path | str = "data/utterances/solutions",
          accept_nearest: bool = False, budget: int = 8,
-         say: Callable[[str], None] | None = None, targets: list[TargetSpec | None] | None = None) -> Plan:
-    """Solve every segment's target (cached) and collect the forces, lips and voicing of each segment."""
+         say: Callable[[str], None] | None = None, targets: list[TargetSpec | None] | None = None,
+         jobs: int = 1) -> Plan:
+    """Solve every segment's target (cached; distinct targets in ``jobs`` processes) and collect the forces,
+    lips and voicing of each segment."""
     targets = _targets(u, source, cfg.muscles.max_force_n) if targets is None else targets
     vt = vt_stage.speaker_tract(cfg)
     default_lips = (float(vt.lips.area_cm2), float(vt.lips.length_cm))
-    ctx = sim = voicer = None
-    if any(t is not None for t in targets):
-        ctx = solve_stage.load_context(maps, None, mesh)
-        if any(t is not None and t.acoustic is not None for t in targets):
-            solve_stage.add_formants(ctx, maps, mesh, config, acoustic_maps)
-            voicer = solve_stage.simulator(mesh, config, voiced=True)
-        if any(t is not None and t.acoustic is None for t in targets):
-            sim = voicer.sim if voicer is not None else solve_stage.simulator(mesh, config)
-    labels, forces, lips, ports, notes, files = [], [], [], [], [], []
+    distinct: dict[str, tuple[int, TargetSpec]] = {}
+    for k, t in enumerate(targets):
+        if t is not None:
+            distinct.setdefault(digest(t.model_dump(mode="json")), (k, t))
+    args = (maps, mesh, acoustic_maps, config, str(solutions), accept_nearest, budget)
+    if jobs > 1 and len(distinct) > 1:
+        from joblib import Parallel, delayed
+
+        answers = Parallel(n_jobs=min(jobs, len(distinct)))(delayed(_solve_alone)(k, t, *args)
+                                                              for k, t in distinct.values())
+    else:
+        answers = _solve_together(list(distinct.values()), *args)
     done: dict[str, tuple] = {}
+    for key, (forces_k, note, path, messages) in zip(distinct, answers):
+        done[key] = (forces_k, note, path)
+        for m in messages:
+            if say:
+                say(m)
+    labels, forces, lips, ports, notes, files = [], [], [], [], [], []
     for k, (s, t) in enumerate(zip(u.segments, targets)):
         if t is None:
             labels.append(s.label or "forces")
@@ -149,10 +160,7 @@ def plan(u: Utterance, cfg: Config, source: Path | str | None = None, maps: Path
             notes.append("forces given")
             files.append("")
             continue
-        key = digest(t.model_dump(mode="json"))
-        if key not in done:
-            done[key] = _solve(t, k, ctx, sim, voicer, cfg, config, Path(solutions), mesh, accept_nearest, budget, say)
-        f, note, path = done[key]
+        f, note, path = done[digest(t.model_dump(mode="json"))]
         labels.append(s.label or t.name)
         forces.append(f)
         lips.append(t.lip_tube(default_lips) if t.acoustic is not None else default_lips)
@@ -163,6 +171,32 @@ def plan(u: Utterance, cfg: Config, source: Path | str | None = None, maps: Path
     return Plan(labels=labels, starts_s=starts, durations_s=np.array([s.duration_ms for s in u.segments]) / 1e3,
                 forces_n=forces, lips=lips, ports=ports, voiced=np.array([s.voiced for s in u.segments]),
                 notes=notes, solutions=files)
+
+
+def _solve_together(items: list[tuple[int, TargetSpec]], maps, mesh, acoustic_maps, config, folder: str,
+                    accept_nearest: bool, budget: int) -> list[tuple]:
+    """Solve targets in this process, the maps and simulators loaded once: (forces, how, path, messages) each."""
+    if not items:
+        return []
+    cfg = load_config(config)
+    ctx = solve_stage.load_context(maps, None, mesh)
+    sim = voicer = None
+    if any(t.acoustic is not None for _, t in items):
+        solve_stage.add_formants(ctx, maps, mesh, config, acoustic_maps)
+        voicer = solve_stage.simulator(mesh, config, voiced=True)
+    if any(t.acoustic is None for _, t in items):
+        sim = voicer.sim if voicer is not None else solve_stage.simulator(mesh, config)
+    out = []
+    for k, t in items:
+        messages: list[str] = []
+        out.append((*_solve(t, k, ctx, sim, voicer, cfg, config, Path(folder), mesh, accept_nearest, budget,
+                            messages.append), messages))
+    return out
+
+
+def _solve_alone(k: int, t: TargetSpec, *args) -> tuple:
+    """One target in a worker process."""
+    return _solve_together([(k, t)], *args)[0]
 
 
 def _solve(t: TargetSpec, k: int, ctx, sim, voicer, cfg, config, folder: Path, mesh, accept_nearest: bool,
@@ -455,7 +489,7 @@ def _check_out(out: Path | str) -> Path:
 def speak(utterance: Path | str, out: Path | str | None = None, maps: Path | str = "data/epmaps.h5",
           mesh: Path | str = "data/mesh.h5", acoustic_maps: Path | str | None = "data/acoustic_maps.h5",
           config: Path | str | None = None, solutions: Path | str | None = None, accept_nearest: bool = False,
-          budget: int = 8, progress=None, say: Callable[[str], None] | None = None) -> SpeakResult:
+          budget: int = 8, progress=None, say: Callable[[str], None] | None = None, jobs: int = 1) -> SpeakResult:
     """Speak an utterance file: WAV, TextGrid and HDF5 (``out``: the WAV; default data/utterances/NAME.wav).
     A record that already holds this recipe (the utterance, its targets' solutions, mesh, config, code) is
     left alone."""
@@ -478,7 +512,7 @@ def speak(utterance: Path | str, out: Path | str | None = None, maps: Path | str
         return SpeakResult(paths, None, up_to_date=True)
     model = sim_stage.build(cfg, m.mesh, m.wall)
     check_forces(u, list(model.drivable()), str(utterance))
-    p = plan(u, cfg, utterance, maps, mesh, acoustic_maps, config, folder, accept_nearest, budget, say, targets)
+    p = plan(u, cfg, utterance, maps, mesh, acoustic_maps, config, folder, accept_nearest, budget, say, targets, jobs)
     s = compute(u, p, cfg, m.mesh, m.wall, progress, model)
     return SpeakResult(write(out, s, prov), s)
 

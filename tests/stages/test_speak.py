@@ -173,19 +173,21 @@ def test_an_unreachable_target_exits_3_naming_its_segment_and_writes_nothing(tmp
     cfg = _write(tmp_path / "cfg.yaml", d)
     build_ep_maps(mesh_file, cfg, tmp_path / "maps.h5", jobs=1, cache=tmp_path / "cache")
     far = {"name": "far", "jaw": {"forces_n": {}}, "crucial": {"point": "tip", "at_cm": [2.0, 3.0], "tolerance_cm": 0.05}}
-    u = _write(tmp_path / "u.yaml", {"name": "u", "segments": [dict(A, duration_ms=60), {"target": far, "duration_ms": 60}]})
+    farther = dict(far, name="farther", crucial=dict(far["crucial"], at_cm=[2.5, 3.0]))
+    u = _write(tmp_path / "u.yaml", {"name": "u", "segments": [dict(A, duration_ms=60), {"target": far, "duration_ms": 60},
+                                                               {"target": farther, "duration_ms": 20}]})
     args = ("speak", u, "--mesh", mesh_file, "--maps", tmp_path / "maps.h5", "--config", cfg,
             "--out", tmp_path / "out" / "u.wav", "--solutions", tmp_path / "sol")
-    res = _run(*args)
+    res = _run(*args, "--jobs", "2")  # the two targets in two processes: the first one's failure is the answer
     assert res.exit_code == 3 and "segment 1" in res.output and "'far'" in res.output, res.output
     assert "--accept-nearest" in res.output and not (tmp_path / "out").exists()
     res = _run(*args, "--accept-nearest", "--animate", tmp_path / "u.gif")
     assert res.exit_code == 0, res.output
     from PIL import Image
 
-    assert Image.open(tmp_path / "u.gif").n_frames == 25  # every 5-ms frame of 120 ms, and the start
+    assert Image.open(tmp_path / "u.gif").n_frames == 29  # every 5-ms frame of 140 ms, and the start
     rec = speak.read(tmp_path / "out" / "u.h5")
-    assert rec.how == ["forces given", "unreachable: nearest answer"]
+    assert rec.how == ["forces given", "unreachable: nearest answer", "unreachable: nearest answer"]
 
 
 def test_praat_finds_our_formant_tracks_in_the_spoken_sound(spoken):
