@@ -78,6 +78,7 @@ class Spoken:
     muscle_force_n: np.ndarray  # (F, M) commanded
     timings_s: dict[str, float]  # wall time of each part: rest, simulation, tract, formants, sound
     segment_eps_cm: np.ndarray  # (K, 3, 3) tip, dorsum, jaw where each segment's forces lead (held from rest)
+    beyond_wall_cm: float  # the farthest any tongue node got beyond the wall
     force_course: str  # static or pulse_step
 
 
@@ -300,6 +301,11 @@ def compute(u: Utterance, p: Plan, cfg: Config, mesh, wall, progress=None, model
     traj, _ = run(model, start, lambda t: Control(node_force=zero, muscle_force=force_at(t)), duration, dt,
                   record_every=every, progress=progress, keep_partial=True)
     lap("simulation")
+    beyond = 0.0
+    if model.contact is not None:  # how far any contact node got beyond the wall (cm)
+        from ..mechanics.contact import wall_query
+
+        beyond = max(0.0, max(float(wall_query(model.contact, x)[2].max()) for x in traj.x))
     bad = sim_stage.problems(traj, model.volume_constraint)
     if bad:
         raise NotPhysical(f"utterance '{u.name}': the simulation is not physical ({'; '.join(bad)}); nothing written")
@@ -344,7 +350,7 @@ def compute(u: Utterance, p: Plan, cfg: Config, mesh, wall, progress=None, model
     commanded = np.array([force_at(float(t)) for t in traj.time])
     return Spoken(utterance=u, plan=p, trajectory=traj, tracts=tracts, formants_hz=formants_hz, noise=tb,
                   glottis_cm2=glottis, audio=audio, control_points=cps, muscle_names=list(model.muscle_names),
-                  muscle_force_n=units.dyn_to_newton(commanded), timings_s=timings, segment_eps_cm=eps,
+                  muscle_force_n=units.dyn_to_newton(commanded), timings_s=timings, segment_eps_cm=eps, beyond_wall_cm=beyond,
                   force_course=how)
 
 
@@ -382,7 +388,8 @@ def write(wav: Path | str, s: Spoken, prov=None) -> dict[str, Path]:
         f.attrs.update({"name": s.utterance.name, "duration_s": float(p.starts_s[-1] + p.durations_s[-1]),
                         "wav": Path(wav).name, "textgrid": tg.name,
                         "max_abs_volume_change": float(np.nanmax(np.abs(s.trajectory.volume_change))),
-                        "inverted_bricks_max": int(s.trajectory.inverted.max())})
+                        "inverted_bricks_max": int(s.trajectory.inverted.max()),
+                        "max_beyond_wall_cm": float(s.beyond_wall_cm)})
         g = f.create_group("segments")
         g.create_dataset("label", data=np.array(p.labels, dtype="S"))
         g.create_dataset("start", data=p.starts_s).attrs["units"] = "s"

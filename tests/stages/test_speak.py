@@ -106,7 +106,8 @@ def test_a_spoken_sequence_writes_its_sound_textgrid_and_record(spoken, mesh_fil
     y, rate = read_wav(spoken / "lab.wav")
     assert len(y) / rate == pytest.approx(1.0, abs=0.002)
     assert (spoken / "lab.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    assert np.nanmax(np.abs(rec.volume_change)) <= 0.003
+    assert np.nanmax(np.abs(rec.volume_change)) <= 0.003 and rec.attrs["max_beyond_wall_cm"] <= 0.01
+    assert rec.attrs["inverted_bricks_max"] == 0
     # the jaw opens for each /a/ (JO 2.5 N) and closes between them
     jaw = rec.control_points["jaw"][:, 1]
     t = rec.time_s
