@@ -94,7 +94,7 @@ def _line(frame_areas, frame_index, source, glottal_reflection, rho, c, fs, loss
         new_b[n - 1] = (b0 * fwd[n - 1] + b1 * last_f - a1 * last_b) / a0
         last_f = fwd[n - 1]
         last_b = new_b[n - 1]
-        u = area[n - 1] * (fwd[n - 1] - new_b[n - 1])
+        u = area[n - 1] * (fwd[n - 1] - new_b[n - 1]) if a_l > 2e-4 else 0.0  # closed lips radiate nothing
         out[s] = u - last_u
         last_u = u
         for j in range(n):

@@ -414,17 +414,22 @@ def utterance_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row
                      f"{sp.get('jaw', np.nan):.1f} cm/s; listen: [{wav.name}]({os.path.relpath(wav, out_dir)}), "
                      f"[{tg.name}]({os.path.relpath(tg, out_dir)})")
         pictures.append(f"![/{name}/: spectrogram, formant tracks, tip / dorsum / jaw heights](utterance_{path.stem}.png)")
-        vowels = [s for s in m["segments"] if s["label"] not in ("k", "t", "s")]
+        vowels = [s for s in m["segments"] if s["label"] not in ("k", "t", "s", "p")]
         vowel_db = float(np.mean([s["level_db"] for s in vowels])) if vowels else np.nan
         if name == "aia":
             f2 = [s["f2_hz"] for s in m["segments"]]
             rise, fall = f2[1] - f2[0], f2[1] - f2[2]
             rows.append(Row("/aia/: F2 rise /a/ -> /i/, fall /i/ -> /a/", ">= 600 Hz each (goal)",
                             f"{rise:+.0f} / {fall:+.0f} Hz", _verdict(rise >= 600 and fall >= 600, ">= 600 Hz")))
-        if name in ("aka", "ata"):
+        if name in ("aka", "ata", "apa"):
             c = max(m["closures"], key=lambda c: c["duration_ms"]) if m["closures"] else None
-            ours = "no closure" if c is None else (f"{c['duration_ms']:.0f} ms, {c['level_db'] - vowel_db:+.0f} dB "
-                                                   "against the vowels")
+            ours = "no closure"
+            if c is not None:
+                from ..acoustics.measures import band_level_db
+
+                burst = band_level_db(y, rate, c["end_s"], c["end_s"] + 0.015, 3000.0)
+                ours = (f"{c['duration_ms']:.0f} ms, {c['level_db'] - vowel_db:+.0f} dB against the vowels; the "
+                        f"release's first 15 ms above 3 kHz {burst - vowel_db:+.0f} dB against the vowels' level")
             ok = c is not None and 40 <= c["duration_ms"] <= 120 and c["level_db"] - vowel_db <= -30
             rows.append(Row(f"/{name}/: closure", "40-120 ms, >= 30 dB below the vowels (goal)", ours,
                             _verdict(ok, "a stop")))
