@@ -143,6 +143,9 @@ def plan(u: Utterance, cfg: Config, source: Path | str | None = None, maps: Path
 
         answers = Parallel(n_jobs=min(jobs, len(distinct)))(delayed(_solve_alone)(k, t, *args)
                                                               for k, t in distinct.values())
+        failed = [a for a in answers if isinstance(a, ArticError)]
+        if failed:  # the earliest segment's problem, whichever process finished first
+            raise failed[0]
     else:
         answers = _solve_together(list(distinct.values()), *args)
     done: dict[str, tuple] = {}
@@ -195,9 +198,12 @@ def _solve_together(items: list[tuple[int, TargetSpec]], maps, mesh, acoustic_ma
     return out
 
 
-def _solve_alone(k: int, t: TargetSpec, *args) -> tuple:
-    """One target in a worker process."""
-    return _solve_together([(k, t)], *args)[0]
+def _solve_alone(k: int, t: TargetSpec, *args) -> tuple | ArticError:
+    """One target in a worker process; its error is returned (the parent raises the first segment's)."""
+    try:
+        return _solve_together([(k, t)], *args)[0]
+    except ArticError as err:
+        return err
 
 
 def _solve(t: TargetSpec, k: int, ctx, sim, voicer, cfg, config, folder: Path, mesh, accept_nearest: bool,
