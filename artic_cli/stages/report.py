@@ -413,7 +413,8 @@ def utterance_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row
                      f"speeds tip / dorsum / jaw {sp.get('tip', np.nan):.1f} / {sp.get('dorsum', np.nan):.1f} / "
                      f"{sp.get('jaw', np.nan):.1f} cm/s; listen: [{wav.name}]({os.path.relpath(wav, out_dir)}), "
                      f"[{tg.name}]({os.path.relpath(tg, out_dir)})")
-        pictures.append(f"![/{name}/: spectrogram, formant tracks, tip / dorsum / jaw heights](utterance_{path.stem}.png)")
+        pictures.append(f"![/{name}/: spectrogram, formant tracks, tip / dorsum / jaw heights]"
+                        f"(utterance_{path.stem}.png)")
         vowels = [s for s in m["segments"] if s["label"] not in ("k", "t", "s", "p")]
         vowel_db = float(np.mean([s["level_db"] for s in vowels])) if vowels else np.nan
         if name == "aia":
@@ -435,7 +436,8 @@ def utterance_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row
                             _verdict(ok, "a stop")))
         if name == "asa":
             s_ = [s for s in m["segments"] if s["label"] == "s"]
-            hf = s_[0]["level_above_3khz_db"] - float(np.mean([s["level_above_3khz_db"] for s in vowels])) if s_ else np.nan
+            vowel_hf = float(np.mean([s["level_above_3khz_db"] for s in vowels]))
+            hf = s_[0]["level_above_3khz_db"] - vowel_hf if s_ else np.nan
             rows.append(Row("/asa/: level above 3 kHz, /s/ against the vowels", ">= +20 dB (goal)", f"{hf:+.1f} dB",
                             _verdict(bool(hf >= 20), "frication")))
         if name.startswith("aia"):
@@ -457,7 +459,8 @@ def utterance_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row
     return rows, lines + [""] + pictures + [""]
 
 
-SECTIONS = {"tissue": tissue_section, "articulator": articulator_section, "tract": tract_section, "function": function_rows,
+SECTIONS = {"tissue": tissue_section, "articulator": articulator_section, "tract": tract_section,
+            "function": function_rows,
             "maps": map_section, "vowels": vowel_section, "utterances": utterance_section}
 
 

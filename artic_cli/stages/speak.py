@@ -356,7 +356,8 @@ def compute(u: Utterance, p: Plan, cfg: Config, mesh, wall, progress=None, model
     commanded = np.array([force_at(float(t)) for t in traj.time])
     return Spoken(utterance=u, plan=p, trajectory=traj, tracts=tracts, formants_hz=formants_hz, noise=tb,
                   glottis_cm2=glottis, audio=audio, control_points=cps, muscle_names=list(model.muscle_names),
-                  muscle_force_n=units.dyn_to_newton(commanded), timings_s=timings, segment_eps_cm=eps, beyond_wall_cm=beyond,
+                  muscle_force_n=units.dyn_to_newton(commanded), timings_s=timings, segment_eps_cm=eps,
+                  beyond_wall_cm=beyond,
                   force_course=how)
 
 

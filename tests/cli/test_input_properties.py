@@ -207,12 +207,12 @@ segment = st.fixed_dictionaries(
     optional={"forces_n": st.one_of(st.dictionaries(muscles, _maybe(numbers), max_size=3), anything),
               "target": st.one_of(st.sampled_from(["configs/targets/velar.yaml", "nowhere.yaml"]), targets),
               "voiced": _maybe(st.booleans()), "label": names})
+contours = st.one_of(st.lists(st.lists(numbers, min_size=2, max_size=2), max_size=3), anything)
+courses = _maybe(st.sampled_from(["static", "pulse_step", "jerk"]))
 utterances = st.one_of(
     st.fixed_dictionaries({"segments": st.one_of(st.lists(segment, max_size=3), anything)},
-                          optional={"name": names, "f0_hz": st.one_of(st.lists(st.lists(numbers, min_size=2, max_size=2),
-                                                                                max_size=3), anything),
-                                    "ramp_ms": _maybe(numbers), "force_course": _maybe(st.sampled_from(
-                                        ["static", "pulse_step", "jerk"])), "tract": st.lists(anything, max_size=2)}),
+                          optional={"name": names, "f0_hz": contours, "ramp_ms": _maybe(numbers),
+                                    "force_course": courses, "tract": st.lists(anything, max_size=2)}),
     anything)
 
 

@@ -92,7 +92,8 @@ def test_a_plotting_edit_redraws_figures_and_recomputes_nothing(built):
     before = _mtimes(built)
     # -W: make sees a plotting module as just edited (a comment edit, as far as make can tell); the
     # tract figures are redrawn, every artefact is left alone
-    res = make("-j2", "paper", "CONFIG=configs/ci_thin.yaml", PIPELINE, f"OUT={built}", "-W", "artic_cli/plots/vocal_tract.py")
+    res = make("-j2", "paper", "CONFIG=configs/ci_thin.yaml", PIPELINE, f"OUT={built}",
+               "-W", "artic_cli/plots/vocal_tract.py")
     assert res.returncode == 0, res.stdout[-3000:] + res.stderr[-3000:]
     ran = [ln for ln in res.stdout.splitlines() if "bin/artic " in ln]
     assert any("artic plot " in ln for ln in ran) and any("artic report" in ln for ln in ran)
@@ -103,7 +104,8 @@ def test_a_plotting_edit_redraws_figures_and_recomputes_nothing(built):
 def test_a_touched_physics_module_reruns_stages_that_find_themselves_up_to_date(built):
     before = _mtimes(built)
     # the equilibrium code: make reruns the EP maps and what reads it, each finds its recipe unchanged
-    res = make("-j2", "paper", "CONFIG=configs/ci_thin.yaml", PIPELINE, f"OUT={built}", "-W", "artic_cli/control/equilibrium.py")
+    res = make("-j2", "paper", "CONFIG=configs/ci_thin.yaml", PIPELINE, f"OUT={built}",
+               "-W", "artic_cli/control/equilibrium.py")
     assert res.returncode == 0, res.stdout[-3000:] + res.stderr[-3000:]
     assert "artic ep-map" in res.stdout and "epmaps.h5 is up to date" in res.stdout
     assert "equilibria (" not in res.stdout  # no equilibrium computed, none even looked up

@@ -86,7 +86,8 @@ LAB = {"name": "lab", "f0_hz": [[0.0, 125], [0.75, 100]],
                     dict(A), {"forces_n": {"JO": 0.5}, "duration_ms": 150, "label": "f", "voiced": False},
                     dict(A), {"forces_n": {"JO": 0.5, "GGp": 4.0, "SL": 1.0}, "duration_ms": 250, "label": "i"}],
        "tract": [{"at_ms": 200, "ramp_ms": 15, "lip_area_cm2": 0.0}, {"at_ms": 300, "ramp_ms": 10, "lip_area_cm2": 3.0},
-                 {"at_ms": 450, "ramp_ms": 20, "lip_area_cm2": 0.08}, {"at_ms": 600, "ramp_ms": 20, "lip_area_cm2": 3.0}]}
+                 {"at_ms": 450, "ramp_ms": 20, "lip_area_cm2": 0.08},
+                 {"at_ms": 600, "ramp_ms": 20, "lip_area_cm2": 3.0}]}
 
 
 @pytest.fixture(scope="module")
@@ -111,7 +112,8 @@ def test_a_spoken_sequence_writes_its_sound_textgrid_and_record(spoken, mesh_fil
     # the jaw opens for each /a/ (JO 2.5 N) and closes between them
     jaw = rec.control_points["jaw"][:, 1]
     t = rec.time_s
-    assert jaw[np.searchsorted(t, 0.19)] < jaw[0] - 0.2 and jaw[np.searchsorted(t, 0.29)] > jaw[np.searchsorted(t, 0.19)]
+    open_, shut = jaw[np.searchsorted(t, 0.19)], jaw[np.searchsorted(t, 0.29)]
+    assert open_ < jaw[0] - 0.2 and shut > open_
     # the TextGrid: one interval per segment, read by praatio (and by Praat when the test extra is there)
     from praatio import textgrid
 
@@ -173,10 +175,11 @@ def test_an_unreachable_target_exits_3_naming_its_segment_and_writes_nothing(tmp
                       levels_n=[0.0, 2.0], pair_levels_n=[2.0], pairs_tip=[["SL", "GGa"]], pairs_dorsum=[], groups=[])
     cfg = _write(tmp_path / "cfg.yaml", d)
     build_ep_maps(mesh_file, cfg, tmp_path / "maps.h5", jobs=1, cache=tmp_path / "cache")
-    far = {"name": "far", "jaw": {"forces_n": {}}, "crucial": {"point": "tip", "at_cm": [2.0, 3.0], "tolerance_cm": 0.05}}
+    far = {"name": "far", "jaw": {"forces_n": {}},
+           "crucial": {"point": "tip", "at_cm": [2.0, 3.0], "tolerance_cm": 0.05}}
     farther = dict(far, name="farther", crucial=dict(far["crucial"], at_cm=[2.5, 3.0]))
-    u = _write(tmp_path / "u.yaml", {"name": "u", "segments": [dict(A, duration_ms=60), {"target": far, "duration_ms": 60},
-                                                               {"target": farther, "duration_ms": 20}]})
+    segments = [dict(A, duration_ms=60), {"target": far, "duration_ms": 60}, {"target": farther, "duration_ms": 20}]
+    u = _write(tmp_path / "u.yaml", {"name": "u", "segments": segments})
     args = ("speak", u, "--mesh", mesh_file, "--maps", tmp_path / "maps.h5", "--config", cfg,
             "--out", tmp_path / "out" / "u.wav", "--solutions", tmp_path / "sol")
     res = _run(*args, "--jobs", "2")  # the two targets in two processes: the first one's failure is the answer
