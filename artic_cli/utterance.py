@@ -28,7 +28,7 @@ from pydantic import Field, field_validator, model_validator
 from .config import read_yaml
 from .errors import ArticError
 from .schedule import TractEntry
-from .validation import DurationMs, ForceN, SafeName, Strict, parse
+from .validation import DurationMs, ForceN, SafeName, Strict, increasing, parse
 
 MAX_UTTERANCE_MS = 20000.0
 
@@ -66,9 +66,7 @@ class Utterance(Strict):
                 raise ValueError(f"point {k}: time {t:g} s is negative")
             if not 50 <= f <= 500:
                 raise ValueError(f"point {k}: F0 {f:g} Hz is outside 50-500 Hz")
-        times = [t for t, _ in v]
-        if any(b <= a for a, b in zip(times, times[1:])):
-            raise ValueError("times must rise strictly (no overlapping or unsorted points)")
+        increasing([t for t, _ in v], "times must rise strictly (no overlapping or unsorted points)")
         return v
 
     @model_validator(mode="after")

@@ -16,6 +16,17 @@ from artic_cli.stages.mesh import build_mesh
 ROOT = Path(__file__).resolve().parent.parent
 
 
+def run_cli(*args):
+    """``artic ARGS`` in-process; anything but a clean exit (a traceback) fails the test."""
+    from typer.testing import CliRunner
+
+    from artic_cli.cli.main import app
+
+    res = CliRunner().invoke(app, [str(a) for a in args])
+    assert res.exception is None or isinstance(res.exception, SystemExit), repr(res.exception)
+    return res
+
+
 @pytest.fixture(scope="session")
 def cfg():
     return load_config(ROOT / "configs" / "default.yaml")

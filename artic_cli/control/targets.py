@@ -13,6 +13,7 @@ import numpy as np
 
 from ..config import read_yaml
 from ..errors import ArticError, UnreachableTarget
+from ..validation import DEFAULT_MAX_FORCE_N
 from .dynamic import DynamicMap, derive
 from .epmap import EPMaps, JawMaps, canonical
 from .solver import Candidate, TargetSpec, parse_target, solve_on
@@ -245,8 +246,8 @@ def solve(ctx: Context, target: TargetSpec, simulator=None, verify: bool = False
     return doc
 
 
-def load_target(path: Path | str) -> TargetSpec:
-    return parse_target(read_yaml(path, "target file"), str(path))
+def load_target(path: Path | str, max_force_n: float = DEFAULT_MAX_FORCE_N) -> TargetSpec:
+    return parse_target(read_yaml(path, "target file"), str(path), max_force_n)
 
 
 # --- batches -----------------------------------------------------------------------------------------

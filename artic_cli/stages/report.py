@@ -387,6 +387,7 @@ def utterance_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row
     sound and its TextGrid; rows for the measures speech needs."""
     import os
 
+    from ..acoustics.measures import band_level_db
     from . import speak as speak_stage
     from .synthesize import read_wav
 
@@ -426,8 +427,6 @@ def utterance_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row
             c = max(m["closures"], key=lambda c: c["duration_ms"]) if m["closures"] else None
             ours = "no closure"
             if c is not None:
-                from ..acoustics.measures import band_level_db
-
                 burst = band_level_db(y, rate, c["end_s"], c["end_s"] + 0.015, 3000.0)
                 ours = (f"{c['duration_ms']:.0f} ms, {c['level_db'] - vowel_db:+.0f} dB against the vowels; the "
                         f"release's first 15 ms above 3 kHz {burst - vowel_db:+.0f} dB against the vowels' level")

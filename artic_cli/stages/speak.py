@@ -27,6 +27,7 @@ from ..acoustics.tube import Tube
 from ..config import Config, load_config
 from ..control.course import course, pulse_step
 from ..control.solver import TargetSpec, parse_target
+from ..control.targets import load_target
 from ..errors import ArticError, NotPhysical, UnreachableTarget
 from ..io.fingerprint import digest
 from ..io.store import atomic_h5, atomic_path, open_artifact, stored_content_hash
@@ -92,14 +93,8 @@ def _targets(u: Utterance, source: Path | str | None, max_force_n: float) -> lis
         elif isinstance(s.target, dict):
             out.append(parse_target(s.target, f"{source}: segments[{k}].target", max_force_n))
         else:
-            out.append(_load_target_file(target_path(s.target, source), max_force_n))
+            out.append(load_target(target_path(s.target, source), max_force_n))
     return out
-
-
-def _load_target_file(path: Path, max_force_n: float) -> TargetSpec:
-    from ..config import read_yaml
-
-    return parse_target(read_yaml(path, "target file"), str(path), max_force_n)
 
 
 def solution_forces(doc: dict) -> tuple[dict[str, float], bool, str]:
@@ -182,7 +177,6 @@ def _solve_together(items: list[tuple[int, TargetSpec]], maps, mesh, acoustic_ma
     """Solve targets in this process, the maps and simulators loaded once: (forces, how, path, messages) each."""
     if not items:
         return []
-    cfg = load_config(config)
     ctx = solve_stage.load_context(maps, None, mesh)
     sim = voicer = None
     if any(t.acoustic is not None for _, t in items):
@@ -190,10 +184,11 @@ def _solve_together(items: list[tuple[int, TargetSpec]], maps, mesh, acoustic_ma
         voicer = solve_stage.simulator(mesh, config, voiced=True)
     if any(t.acoustic is None for _, t in items):
         sim = voicer.sim if voicer is not None else solve_stage.simulator(mesh, config)
+    mesh_sha = (voicer.sim if voicer is not None else sim).mesh_sha256
     out = []
     for k, t in items:
         messages: list[str] = []
-        out.append((*_solve(t, k, ctx, sim, voicer, cfg, config, Path(folder), mesh, accept_nearest, budget,
+        out.append((*_solve(t, k, ctx, sim, voicer, config, Path(folder), mesh_sha, accept_nearest, budget,
                             messages.append), messages))
     return out
 
@@ -206,11 +201,8 @@ def _solve_alone(k: int, t: TargetSpec, *args) -> tuple | ArticError:
         return err
 
 
-def _solve(t: TargetSpec, k: int, ctx, sim, voicer, cfg, config, folder: Path, mesh, accept_nearest: bool,
+def _solve(t: TargetSpec, k: int, ctx, sim, voicer, config, folder: Path, mesh_sha: str, accept_nearest: bool,
            budget: int, say) -> tuple[dict, str, Path]:
-    from ..stages.mesh import read as read_mesh
-
-    mesh_sha = read_mesh(mesh, cfg).content_sha256
     runner = voicer if t.acoustic is not None else sim
     out = folder / f"{t.name}-{digest(t.model_dump(mode='json'))[:8]}.yaml"
     try:

@@ -6,21 +6,13 @@ from __future__ import annotations
 import h5py
 import pytest
 import yaml
-from typer.testing import CliRunner
 
-from artic_cli.cli.main import app
 from artic_cli.errors import ArticError
 from artic_cli.stages.simulate import read
 
-from conftest import ROOT
+from conftest import ROOT, run_cli
 
-RUNNER = CliRunner()
-
-
-def _run(*args):
-    res = RUNNER.invoke(app, [str(a) for a in args])
-    assert res.exception is None or isinstance(res.exception, SystemExit), repr(res.exception)
-    return res
+_run = run_cli
 
 
 def test_a_nan_in_a_target_is_refused_before_any_search(tmp_path, monkeypatch):

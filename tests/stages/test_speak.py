@@ -7,24 +7,16 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import yaml
-from typer.testing import CliRunner
 
 from artic_cli.acoustics.aerodynamics import flow, noise_rms, reynolds
 from artic_cli.acoustics.measures import band_level_db
-from artic_cli.cli.main import app
 from artic_cli.control.course import course
 from artic_cli.stages import speak
 from artic_cli.stages.synthesize import read_wav
 
-from conftest import ROOT
+from conftest import ROOT, run_cli
 
-RUNNER = CliRunner()
-
-
-def _run(*args):
-    res = RUNNER.invoke(app, [str(a) for a in args])
-    assert res.exception is None or isinstance(res.exception, SystemExit), repr(res.exception)
-    return res
+_run = run_cli
 
 
 def _write(path, doc):
