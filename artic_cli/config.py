@@ -114,6 +114,9 @@ class Muscles(Strict):
     maxwell_b2_ratio: Positive = 0.1
     # Eq. (9) evaluated at fibre strain / width: 1 is the paper's curve (active force zero below -18.5 %)
     force_length_width: Annotated[float, Field(ge=1.0, le=5.0)] = 1.0
+    # routing (docs/modelling.md): the verticalis over this many radial sections from the tip; IL also midsagittally
+    verticalis_sections: Annotated[int, Field(ge=1)] = 4
+    il_midsagittal: bool = False
     groups: dict[str, dict[str, Positive]] = {
         "JO": {"lateral_pterygoid_upper": 0.25, "lateral_pterygoid_lower": 0.25, "anterior_digastric": 0.5},
         "JC": {"temporalis_anterior": 0.3, "temporalis_posterior": 0.2, "masseter": 0.3, "medial_pterygoid": 0.2},
@@ -133,6 +136,9 @@ class Jaw(Strict):
     passive_stiffness_n_per_cm: NonNeg = 0.5
     passive_relaxation_ms: NonNeg = 100.0  # jaw units' and straps' dashpots: this time x their spring
     strap_stiffness_n_per_cm: NonNeg = 10.0
+    # the anterior digastric's fibre runs on through the hyoid sling to the mastoid, so its strain is taken over
+    # the whole digastric; false: it ends at the sling, as the paper's (docs/modelling.md)
+    digastric_through_sling: bool = False
     floor_link_area_cm2: Positive = 0.3
 
 

@@ -84,9 +84,18 @@ def _landmark(cfg: Config, key: str):
         raise ArticError(f"config: speaker.landmarks_cm lacks '{key}'; add it (x, y, z in cm)") from None
 
 
-def build_body(cfg: Config, mesh: Mesh | None = None) -> Body:
+def build_body(cfg: Config, mesh: Mesh | None = None, *, digastric_through_sling: bool = False,
+               verticalis_sections: int = 4, il_midsagittal: bool = False) -> Body:
+    """The articulator's nodes, links and muscle routes.
+
+    ``digastric_through_sling``: the anterior digastric's fibre goes on from the sling to the mastoid (a fixed
+    segment that adds its length to the fibre's); ``verticalis_sections``: the verticalis spans this many radial
+    sections from the tip; ``il_midsagittal``: IL has a fibre in the midsagittal plane as well."""
     mesh = mesh if mesh is not None else tongue_mesh(cfg.speaker.tongue)
     nr, nc, planes = mesh.grid
+    if not 1 <= verticalis_sections <= nr - 1:
+        raise ArticError(f"config: muscles.verticalis_sections is {verticalis_sections}; give 1 to {nr - 1} "
+                         "(the tongue's radial sections)")
     t = lambda k, j, p: int(tongue_node_index(k, j, p, nc - 1))  # noqa: E731
     b = _Builder(mesh)
     lm = lambda key: _landmark(cfg, key)  # noqa: E731
@@ -182,8 +191,10 @@ def build_body(cfg: Config, mesh: Mesh | None = None) -> Body:
                 fib["HG"].append(chain([h] + [t(k, j, p) for k in range(last, 6, -1)]))
         fib["SG"].append(chain([styloid[s], t(8, 4, p)] + [t(k, 3, p) for k in range(7, 0, -1)]))
         fib["SG"].append(chain([styloid[s], t(7, 5, p)] + [t(k, 5, p) for k in range(6, 2, -1)]))
-        # lower side, root to tip, parasagittal planes only (between GG and HG)
+    # lower side, root to tip, in the parasagittal planes (between GG and HG) and optionally the midsagittal one
+    for p in (*sides, mid) if il_midsagittal else sides:
         fib["IL"].append(chain([t(k, 2, p) for k in range(last, 0, -1)] + [t(0, j, p) for j in range(3, nc)]))
+    for s, p in enumerate(sides):
         fib["MH"].append(chain([myl_front[s], t(last, 1, mid)]))
         fib["MH"].append(chain([myl_mid[s], t(last, 3, mid)]))
         fib["MH"].append(chain([myl_back[s], t(last, 5, mid)]))
@@ -195,17 +206,17 @@ def build_body(cfg: Config, mesh: Mesh | None = None) -> Body:
         fib["medial_pterygoid"].append(chain([med_pt[s], jaw["gonion"][s]]))
         fib["lateral_pterygoid_upper"].append(chain([lat_u[s], jaw["condyle"][s]]))
         fib["lateral_pterygoid_lower"].append(chain([lat_l[s], jaw["condyle"][s]]))
-        fib["anterior_digastric"].append(chain([dig_fossa[s], sling[s]]))
+        fib["anterior_digastric"].append(chain([dig_fossa[s], sling[s]] + ([mastoid[s]] if digastric_through_sling else [])))
         fib["posterior_digastric"].append(chain([mastoid[s], (body_l, body_r)[s]]))
     for p in range(planes):
         fib["SL"].append(chain([t(k, nc - 2, p) for k in range(8, 0, -1)] + [t(0, nc - 1, p)]))
         if p != mid:
-            for k in range(0, 4):
+            for k in range(verticalis_sections):
                 fib["V"].append(chain([t(k, j, p) for j in range(nc - 1, 2, -1)]))
     for k in range(2, 8):
         for j in (nc - 3, nc - 2):
             fib["T"].append(chain([t(k, j, 0), t(k, j, mid), t(k, j, planes - 1)]))
-    for k in range(0, 4):  # front part of the tongue, dorsum down into the blade
+    for k in range(verticalis_sections):  # front part of the tongue, dorsum down into the blade
         fib["V"].append(chain([t(k, j, mid) for j in range(nc - 1, 2, -1)]))
 
     nodes = np.array(b.points)

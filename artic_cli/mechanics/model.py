@@ -297,7 +297,7 @@ def _links(body: Body, cfg: Config, tissue_scale: float) -> tuple[CylinderSet, n
     x = body.nodes
     pairs = [body.links]
     kinds = [body.link_kind]
-    passive = np.array([f for m in JAW_MUSCLES for f in body.fibres[m]], dtype=np.int64)
+    passive = np.array([f[:2] for m in JAW_MUSCLES for f in body.fibres[m]], dtype=np.int64)  # the moving segment
     pairs.append(passive)
     kinds.append(np.full(len(passive), -1))
     pairs = np.vstack(pairs)
@@ -345,7 +345,8 @@ def build_articulator(cfg: Config, mesh: Mesh, wall: WallSurface | None = None, 
                       volume_constraint: bool | None = None, contact: bool | None = None,
                       gravity: float | None = None) -> Model:
     """Tongue, jaw and hyoid with all muscles, the condyle guide and (optionally) wall contact."""
-    body = build_body(cfg, mesh)
+    body = build_body(cfg, mesh, digastric_through_sling=cfg.jaw.digastric_through_sling,
+                      verticalis_sections=cfg.muscles.verticalis_sections, il_midsagittal=cfg.muscles.il_midsagittal)
     n = len(body.nodes)
     tissue = cfg.materials.tongue
     tcyl, scale, bulk_ratio = tongue_cylinders(mesh, tissue, n)

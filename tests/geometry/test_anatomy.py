@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from artic_cli.errors import ArticError
 from artic_cli.geometry.anatomy import build_body
 
 
@@ -15,6 +16,29 @@ def test_a_bilateral_muscle_never_crosses_the_midline(cfg, muscle):
     for fibre in body.fibres[muscle]:
         z = body.nodes[fibre, 2]
         off = z[np.abs(z) > 1e-9]  # midsagittal nodes (MH's and GH's tongue ends) belong to both sides
+        if not len(off) and muscle == "IL" and cfg.muscles.il_midsagittal:
+            continue  # IL's midsagittal fibre
         assert len(off) and (np.all(off > 0) or np.all(off < 0)), (muscle, z)
         sides.append(np.sign(off[0]))
     assert sides.count(1.0) == sides.count(-1.0)  # as many fibres left as right
+
+
+def test_the_anterior_digastric_ends_at_the_sling_or_runs_on_to_the_mastoid(cfg):
+    paper, through = build_body(cfg), build_body(cfg, digastric_through_sling=True)
+    fixed = set(through.fixed.tolist())
+    for a, b in zip(paper.fibres["anterior_digastric"], through.fibres["anterior_digastric"]):
+        assert len(a) == 2 and len(b) == 3 and np.array_equal(a, b[:2])
+        assert {int(b[1]), int(b[2])} <= fixed  # sling and mastoid: the added segment never changes length
+        post = [f for f in through.fibres["posterior_digastric"] if np.sign(through.nodes[f[0], 2]) == np.sign(
+            through.nodes[b[2], 2])]
+        assert int(b[2]) == int(post[0][0])  # the mastoid end of the same side's posterior belly
+
+
+def test_verticalis_extent_and_a_midsagittal_il_follow_the_config(cfg):
+    body = build_body(cfg, verticalis_sections=6, il_midsagittal=True)
+    paper = build_body(cfg)
+    assert len(body.fibres["V"]) == 3 * 6 and len(paper.fibres["V"]) == 3 * 4  # one fibre per plane and section
+    mid = [f for f in body.fibres["IL"] if np.allclose(body.nodes[f, 2], 0.0)]
+    assert len(body.fibres["IL"]) == 3 and len(mid) == 1 and len(paper.fibres["IL"]) == 2
+    with pytest.raises(ArticError, match="muscles.verticalis_sections"):
+        build_body(cfg, verticalis_sections=11)

@@ -115,11 +115,11 @@ def test_jaw_equilibria_move_monotonically_with_force(jaw_rows):
     assert all(b > a for a, b in zip(jc, jc[1:])) and jc[0] > 0
 
 
-def test_jaw_equilibria_within_a_factor_of_two_of_the_paper(jaw_rows):
+def test_jaw_equilibria_within_25_percent_of_the_paper(jaw_rows):
     eps = [r for r in jaw_rows if r.name.startswith(("JO", "JC"))]
     assert len(eps) == 8
     for r in eps:
-        assert 0.5 <= r.ours / r.paper <= 2.0, r
+        assert abs(r.ours / r.paper - 1) <= 0.25, r
 
 
 @pytest.fixture(scope="module")
@@ -162,13 +162,12 @@ def directions(art, cfg):
 
 
 AGREE = [("GGa", "tip"), ("GGm", "tip"), ("GGm", "dorsum"), ("GGp", "dorsum"), ("HG", "tip"), ("HG", "dorsum"),
-         ("SG", "tip"), ("SG", "dorsum"), ("SL", "tip"), ("SL", "dorsum"), ("V", "tip"), ("V", "dorsum"),
-         ("MH", "dorsum")]
+         ("SG", "tip"), ("SG", "dorsum"), ("SL", "tip"), ("SL", "dorsum"), ("IL", "tip"), ("V", "tip"),
+         ("V", "dorsum"), ("MH", "dorsum")]
 KNOWN = {("GGp", "tip"): "GGp pulls the root forward and the blunt 2-cm tip slides forward and down (60 deg from "
                          "forward-up) about the GG tendon, a rigid inner arc carried by the jaw",
-         ("IL", "tip"): "in a radial fan centred on the GG origin the tongue's lower side is a short arc around "
-                        "the origin; IL shortening squeezes toward it and moves the tip 0.2 cm forward-up",
-         ("IL", "dorsum"): "the same arc pulls the dorsum back-down toward the origin, not back-up"}
+         ("IL", "dorsum"): "in a radial fan centred on the GG origin the tongue's lower side is a short arc around "
+                           "the origin; IL pulls the dorsum back-down toward it (73 deg from back-up)"}
 
 
 def _angle(row) -> float:
@@ -177,7 +176,8 @@ def _angle(row) -> float:
 
 @pytest.mark.parametrize("muscle,cp", AGREE)
 def test_muscle_moves_its_control_point_the_paper_s_way(directions, muscle, cp):
-    assert _angle(directions[f"{muscle} {cp}"]) <= 45.0
+    row = directions[f"{muscle} {cp}"]
+    assert _angle(row) <= 45.0 and row.ours >= 0.05  # the goal: within 45 deg, a move of 0.05 cm or more
 
 
 @pytest.mark.parametrize("muscle,cp", sorted(KNOWN))
