@@ -206,7 +206,8 @@ def build_body(cfg: Config, mesh: Mesh | None = None, *, digastric_through_sling
         fib["medial_pterygoid"].append(chain([med_pt[s], jaw["gonion"][s]]))
         fib["lateral_pterygoid_upper"].append(chain([lat_u[s], jaw["condyle"][s]]))
         fib["lateral_pterygoid_lower"].append(chain([lat_l[s], jaw["condyle"][s]]))
-        fib["anterior_digastric"].append(chain([dig_fossa[s], sling[s]] + ([mastoid[s]] if digastric_through_sling else [])))
+        beyond = [mastoid[s]] if digastric_through_sling else []  # the fixed segment on to the mastoid
+        fib["anterior_digastric"].append(chain([dig_fossa[s], sling[s], *beyond]))
         fib["posterior_digastric"].append(chain([mastoid[s], (body_l, body_r)[s]]))
     for p in range(planes):
         fib["SL"].append(chain([t(k, nc - 2, p) for k in range(8, 0, -1)] + [t(0, nc - 1, p)]))

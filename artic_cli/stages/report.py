@@ -112,7 +112,8 @@ def articulator_rows(data: Path) -> list[Row]:
         r = f4[f"SG+JO {cp} peak speed"]
         ratio = r["ours"] / paper
         rows.append(Row(f"Fig. 4 / Table II: SG 4 N + JO 3 N, {cp} peak speed in 20 ms", f"{paper} cm/s",
-                        f"{r['ours']:.1f} cm/s", _verdict(abs(ratio - 1) <= 0.25, f"{ratio - 1:+.0%}, goal within 25 %")))
+                        f"{r['ours']:.1f} cm/s",
+                        _verdict(abs(ratio - 1) <= 0.25, f"{ratio - 1:+.0%}, goal within 25 %")))
     md = _experiment(data, "muscle-directions")
     agree, differ = [], []
     for name, r in md.items():
