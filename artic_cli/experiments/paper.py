@@ -11,7 +11,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from ..mechanics.contact import wall_query
+from ..mechanics.contact import farthest_beyond_wall, wall_query
 from ..mechanics.jaw_hold import fresh_start, hold_jaw
 from ..mechanics.loads import control_from_newtons
 from ..mechanics.model import Model
@@ -76,8 +76,7 @@ class Audit:
         self.volume = max(self.volume, float(np.abs(traj.volume_change).max()))
         self.inverted = max(self.inverted, int(traj.inverted.max()))
         if self.model.contact is not None:
-            for x in traj.x:
-                self.penetration = max(self.penetration, float(wall_query(self.model.contact, x)[2].max()))
+            self.penetration = max(self.penetration, farthest_beyond_wall(self.model.contact, traj.x))
         return traj, end
 
     def rows(self) -> list[Row]:

@@ -228,6 +228,11 @@ def wall_query(cm: ContactModel, x: np.ndarray, nodes: np.ndarray | None = None)
     return q, n, g, use_jaw
 
 
+def farthest_beyond_wall(cm: ContactModel, frames) -> float:
+    """The largest signed gap (cm, > 0: beyond the wall) of any contact node over the positions ``frames``."""
+    return max(float(wall_query(cm, x)[2].max()) for x in frames)
+
+
 def contact_planes(cm: ContactModel, x: np.ndarray, query=None) -> ContactPlanes:
     """The step's planes for the nodes within ``margin`` of the wall (``query``: a wall_query at x)."""
     q, n, g, jaw = wall_query(cm, x) if query is None else query

@@ -29,6 +29,11 @@ def _verdict(ok: bool, detail: str) -> str:
     return ("agrees" if ok else "differs") + f" ({detail})"
 
 
+def _within(ratio: float, tolerance: float) -> str:
+    """Verdict on ours / paper's being within ``tolerance`` (a fraction) of 1."""
+    return _verdict(abs(ratio - 1) <= tolerance, f"{ratio - 1:+.0%}, goal within {100 * tolerance:g} %")
+
+
 def _sim(path: Path) -> h5py.File:
     return open_artifact(path, "simulation", f"rerun 'make paper' to produce {path}")
 
@@ -101,7 +106,7 @@ def articulator_rows(data: Path) -> list[Row]:
     for r in eps:
         ratio = r["ours"] / r["paper"]
         rows.append(Row(f"Jaw EP, {r['name']} for 300 ms", f"{r['paper']:+.2f} cm", f"{r['ours']:+.3f} cm",
-                        _verdict(abs(ratio - 1) <= 0.25, f"{ratio - 1:+.0%}, goal within 25 %")))
+                        _within(ratio, 0.25)))
     jo = [r["ours"] for r in eps if r["name"].startswith("JO")]
     jc = [r["ours"] for r in eps if r["name"].startswith("JC")]
     mono = all(b < a for a, b in zip(jo, jo[1:])) and all(b > a for a, b in zip(jc, jc[1:]))
@@ -112,8 +117,7 @@ def articulator_rows(data: Path) -> list[Row]:
         r = f4[f"SG+JO {cp} peak speed"]
         ratio = r["ours"] / paper
         rows.append(Row(f"Fig. 4 / Table II: SG 4 N + JO 3 N, {cp} peak speed in 20 ms", f"{paper} cm/s",
-                        f"{r['ours']:.1f} cm/s",
-                        _verdict(abs(ratio - 1) <= 0.25, f"{ratio - 1:+.0%}, goal within 25 %")))
+                        f"{r['ours']:.1f} cm/s", _within(ratio, 0.25)))
     md = _experiment(data, "muscle-directions")
     agree, differ = [], []
     for name, r in md.items():

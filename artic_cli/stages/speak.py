@@ -301,9 +301,9 @@ def compute(u: Utterance, p: Plan, cfg: Config, mesh, wall, progress=None, model
     lap("simulation")
     beyond = 0.0
     if model.contact is not None:  # how far any contact node got beyond the wall (cm)
-        from ..mechanics.contact import wall_query
+        from ..mechanics.contact import farthest_beyond_wall
 
-        beyond = max(0.0, max(float(wall_query(model.contact, x)[2].max()) for x in traj.x))
+        beyond = max(0.0, farthest_beyond_wall(model.contact, traj.x))
     bad = sim_stage.problems(traj, model.volume_constraint)
     if bad:
         raise NotPhysical(f"utterance '{u.name}': the simulation is not physical ({'; '.join(bad)}); nothing written")
