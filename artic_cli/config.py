@@ -140,6 +140,12 @@ class Jaw(Strict):
     # the whole digastric; false: it ends at the sling, as the paper's (docs/modelling.md)
     digastric_through_sling: bool = False
     floor_link_area_cm2: Positive = 0.3
+    # the planes in which the mandible carries the tongue's GG tendon line (innermost concentric line): all
+    # three, or the midsagittal one only, where the genial tubercle is (docs/modelling.md)
+    gg_tendon: Literal["all", "midsagittal"] = "all"
+    # the tongue floor's links to the hyoid bear compression only, their tension levelling off over this
+    # strain (the floor rests on the hyoid); null: full springs (docs/modelling.md)
+    floor_slack_strain: Annotated[float, Field(gt=0, le=1)] | None = None
 
 
 class Contact(Strict):

@@ -85,12 +85,13 @@ def _landmark(cfg: Config, key: str):
 
 
 def build_body(cfg: Config, mesh: Mesh | None = None, *, digastric_through_sling: bool = False,
-               verticalis_sections: int = 4, il_midsagittal: bool = False) -> Body:
+               verticalis_sections: int = 4, il_midsagittal: bool = False, gg_tendon: str = "all") -> Body:
     """The articulator's nodes, links and muscle routes.
 
     ``digastric_through_sling``: the anterior digastric's fibre goes on from the sling to the mastoid (a fixed
     segment that adds its length to the fibre's); ``verticalis_sections``: the verticalis spans this many radial
-    sections from the tip; ``il_midsagittal``: IL has a fibre in the midsagittal plane as well."""
+    sections from the tip; ``il_midsagittal``: IL has a fibre in the midsagittal plane as well; ``gg_tendon``:
+    the mandible carries the tongue's GG tendon line in ``"all"`` three planes or the ``"midsagittal"`` one."""
     mesh = mesh if mesh is not None else tongue_mesh(cfg.speaker.tongue)
     nr, nc, planes = mesh.grid
     if not 1 <= verticalis_sections <= nr - 1:
@@ -133,6 +134,8 @@ def build_body(cfg: Config, mesh: Mesh | None = None, *, digastric_through_sling
     frame = [jaw["symphysis"][0], jaw["symphysis"][1], jaw["coronoid"][0], jaw["gonion"][1]]
     carried = [incisor, gh_origin, *myl_front, *myl_back, *myl_mid, *dig_fossa]
     anchor = mesh.node_sets["anchor"]
+    if gg_tendon == "midsagittal":  # the genial tubercle is in the midline; the lateral tendon nodes are tissue
+        anchor = np.intersect1d(anchor, mesh.node_sets["midsagittal"])
 
     # --- hyoid: body ends and horn tips, braced ---------------------------------------
     body_l, body_r = b.bilateral("hyoid_body", lm("hyoid_body_end"))

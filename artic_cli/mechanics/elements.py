@@ -7,8 +7,12 @@ A = A0 (1 - nu e)^2, and carries the axial tension
     T = (E(e) e + eta de/dt) A,
 
 where E(e) = E0 below the stiffening strain and E0 exp(rate (e - e_s)) above
-it (Duck 1990, as the paper uses).  All functions take and return arrays over
-every cylinder at once, in CGS units.
+it (Duck 1990, as the paper uses).  A link with a finite ``slack`` strain d
+bears compression only: its tension E0 A (e - e^2 / (2 d)) levels off over
+0 < e < d at E0 A d / 2 and stays there (the tongue floor resting on the
+hyoid: it pushes, it barely pulls; the tangent stays continuous and >= 0).
+All functions take and return arrays over every cylinder at once, in CGS
+units.
 
 Within one time step the dashpot acts along the cylinder's axis at the start
 of the step, with that step's cross-section (``DampingFrame``).  The viscous
@@ -45,6 +49,12 @@ class CylinderSet:
     knee: np.ndarray  # stiffening strain
     rate: np.ndarray  # stiffening rate
     n_nodes: int
+    slack: np.ndarray | None = None  # (C,) strain over which tension levels off (inf or None: a full spring)
+
+    @cached_property
+    def slack_strain(self) -> np.ndarray:
+        """(C,) the slack strain of every cylinder, inf where it bears tension fully."""
+        return np.full(len(self.i), np.inf) if self.slack is None else np.asarray(self.slack, dtype=float)
 
     def __len__(self) -> int:
         return len(self.i)
@@ -79,20 +89,29 @@ class DampingFrame:
 
 
 def youngs_modulus(cyl: CylinderSet, strain: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """E(e) and dE/de."""
+    """E(e) and dE/de (the secant modulus: tension = E(e) e A)."""
     over = strain - cyl.knee
-    if not (over > 0).any():
-        return cyl.youngs, np.zeros_like(strain)
-    growth = np.exp(np.minimum(cyl.rate * np.maximum(over, 0.0), 50.0))
-    e = cyl.youngs * growth
-    de = np.where(over > 0, cyl.rate * e, 0.0)
+    e, de = cyl.youngs, np.zeros_like(strain)
+    if (over > 0).any():
+        growth = np.exp(np.minimum(cyl.rate * np.maximum(over, 0.0), 50.0))
+        e = cyl.youngs * growth
+        de = np.where(over > 0, cyl.rate * e, 0.0)
+    d = cyl.slack_strain
+    slack = (strain > 0) & np.isfinite(d)
+    if slack.any():
+        e, de = np.array(e, dtype=float, copy=True), np.array(de, dtype=float, copy=True)
+        e0, s, dd = np.broadcast_to(cyl.youngs, strain.shape)[slack], strain[slack], d[slack]
+        level = s >= dd  # tension held at E0 d / 2
+        e[slack] = np.where(level, e0 * dd / (2.0 * np.maximum(s, 1e-300)), e0 * (1.0 - s / (2.0 * dd)))
+        de[slack] = np.where(level, -e0 * dd / (2.0 * np.maximum(s, 1e-300) ** 2), -e0 / (2.0 * dd))
     return e, de
 
 
 def evaluate(cyl: CylinderSet, x: np.ndarray) -> CylinderState:
     if kernels.AVAILABLE and USE_KERNELS:
         n, length, strain, shrink, e, de, elastic = kernels.cylinder_state(
-            np.ascontiguousarray(x), cyl.i, cyl.j, cyl.l0, cyl.area0, cyl.youngs, cyl.poisson, cyl.knee, cyl.rate)
+            np.ascontiguousarray(x), cyl.i, cyl.j, cyl.l0, cyl.area0, cyl.youngs, cyl.poisson, cyl.knee, cyl.rate,
+            cyl.slack_strain)
         return CylinderState(n=n, length=length, strain=strain, elastic=elastic, shrink=shrink, e=e, de=de)
     return evaluate_numpy(cyl, x)
 
@@ -146,4 +165,11 @@ def strain_energy(cyl: CylinderSet, strain: np.ndarray, points: int = 8) -> np.n
     shrink = np.maximum(1.0 - cyl.poisson * e, 0.05)
     over = np.maximum(e - cyl.knee, 0.0)
     stress = cyl.youngs * np.exp(np.minimum(cyl.rate * over, 50.0)) * e * shrink * shrink
-    return cyl.area0 * cyl.l0 * 0.5 * strain * (w[:, None] * stress).sum(axis=0)
+    energy = cyl.area0 * cyl.l0 * 0.5 * strain * (w[:, None] * stress).sum(axis=0)
+    d = cyl.slack_strain
+    slack = (strain > 0) & np.isfinite(d)
+    if slack.any():  # the slack law in closed form (its links have no radius law: poisson 0)
+        st, dd = strain[slack], d[slack]
+        density = np.where(st < dd, st**2 / 2.0 - st**3 / (6.0 * dd), dd**2 / 3.0 + dd * (st - dd) / 2.0)
+        energy[slack] = (cyl.area0 * cyl.l0 * np.broadcast_to(cyl.youngs, strain.shape))[slack] * density
+    return energy

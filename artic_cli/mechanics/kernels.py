@@ -28,8 +28,9 @@ except ImportError:  # pragma: no cover
 
 
 @njit(cache=True, fastmath=False)
-def cylinder_state(x, ci, cj, l0, area0, youngs, poisson, knee, rate):
-    """Per cylinder: unit axis n (C,3), length, strain, shrink, E, dE/de, elastic tension."""
+def cylinder_state(x, ci, cj, l0, area0, youngs, poisson, knee, rate, slack):
+    """Per cylinder: unit axis n (C,3), length, strain, shrink, E, dE/de, elastic tension (the slack law
+    as elements.youngs_modulus)."""
     c = len(ci)
     n = np.empty((c, 3))
     length = np.empty(c)
@@ -55,7 +56,14 @@ def cylinder_state(x, ci, cj, l0, area0, youngs, poisson, knee, rate):
             sh = 0.05
         shrink[k] = sh
         over = s - knee[k]
-        if over > 0.0:
+        if s > 0.0 and slack[k] < np.inf:
+            if s >= slack[k]:
+                e[k] = youngs[k] * slack[k] / (2.0 * s)
+                de[k] = -youngs[k] * slack[k] / (2.0 * s * s)
+            else:
+                e[k] = youngs[k] * (1.0 - s / (2.0 * slack[k]))
+                de[k] = -youngs[k] / (2.0 * slack[k])
+        elif over > 0.0:
             g = min(rate[k] * over, 50.0)
             ek = youngs[k] * np.exp(g)
             e[k] = ek

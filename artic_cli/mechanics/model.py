@@ -326,15 +326,18 @@ def _links(body: Body, cfg: Config, tissue_scale: float) -> tuple[CylinderSet, n
         m = kinds == LINK_KINDS.index(kind)
         mass[m] = total * l0[m] / l0[m].sum()  # spread uniformly over the bone's links
     n = len(i)
+    slack = np.full(n, np.inf)
+    if jaw.floor_slack_strain is not None:  # the floor rests on the hyoid: compression only
+        slack[floor] = jaw.floor_slack_strain
     cyl = CylinderSet(i=i, j=j, l0=l0, area0=area, youngs=e, viscosity=eta, poisson=np.zeros(n),
-                      knee=np.full(n, np.inf), rate=np.zeros(n), n_nodes=len(x))
+                      knee=np.full(n, np.inf), rate=np.zeros(n), n_nodes=len(x), slack=slack)
     return cyl, mass
 
 
 def _concat(a: CylinderSet, b: CylinderSet) -> CylinderSet:
     return CylinderSet(**{f: np.concatenate([getattr(a, f), getattr(b, f)]) for f in
                           ("i", "j", "l0", "area0", "youngs", "viscosity", "poisson", "knee", "rate")},
-                       n_nodes=a.n_nodes)
+                       slack=np.concatenate([a.slack_strain, b.slack_strain]), n_nodes=a.n_nodes)
 
 
 # the config sections building the articulator reads (build_articulator is handed a view of just these)
@@ -346,7 +349,8 @@ def build_articulator(cfg: Config, mesh: Mesh, wall: WallSurface | None = None, 
                       gravity: float | None = None) -> Model:
     """Tongue, jaw and hyoid with all muscles, the condyle guide and (optionally) wall contact."""
     body = build_body(cfg, mesh, digastric_through_sling=cfg.jaw.digastric_through_sling,
-                      verticalis_sections=cfg.muscles.verticalis_sections, il_midsagittal=cfg.muscles.il_midsagittal)
+                      verticalis_sections=cfg.muscles.verticalis_sections, il_midsagittal=cfg.muscles.il_midsagittal,
+                      gg_tendon=cfg.jaw.gg_tendon)
     n = len(body.nodes)
     tissue = cfg.materials.tongue
     tcyl, scale, bulk_ratio = tongue_cylinders(mesh, tissue, n)

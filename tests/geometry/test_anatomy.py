@@ -42,3 +42,14 @@ def test_verticalis_extent_and_a_midsagittal_il_follow_the_config(cfg):
     assert len(body.fibres["IL"]) == 3 and len(mid) == 1 and len(paper.fibres["IL"]) == 2
     with pytest.raises(ArticError, match="muscles.verticalis_sections"):
         build_body(cfg, verticalis_sections=11)
+
+
+def test_the_mandible_carries_the_gg_tendon_in_every_plane_or_in_the_midline_only(cfg):
+    every, mid = build_body(cfg), build_body(cfg, gg_tendon="midsagittal")
+    anchor = every.mesh.node_sets["anchor"]
+    n_lines = cfg.speaker.tongue.radial_sections + 1
+    held_every = np.intersect1d(every.carried, anchor)
+    held_mid = np.intersect1d(mid.carried, anchor)
+    assert len(held_every) == 3 * n_lines and len(held_mid) == n_lines
+    assert np.allclose(mid.nodes[held_mid, 2], 0.0)  # the genial tubercle's plane
+    assert np.array_equal(np.setdiff1d(every.carried, anchor), np.setdiff1d(mid.carried, anchor))  # bones alike

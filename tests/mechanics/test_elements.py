@@ -81,3 +81,60 @@ def test_isotropy_correction_removes_the_brick_shape_bias():
     assert paper[0] / paper[1] > 2.0  # the paper's rule: much stiffer along x
     assert abs(iso[0] / iso[1] - 1.0) < abs(paper[0] / paper[1] - 1.0) / 3
 
+
+
+def _slack_links(delta=0.01, n=400):
+    strain = np.linspace(-0.05, 0.05, n)
+    cyl = elements.CylinderSet(i=np.zeros(n, dtype=np.int64), j=np.ones(n, dtype=np.int64), l0=np.full(n, 1.5),
+                               area0=np.full(n, 0.3), youngs=np.full(n, 2.0e5), viscosity=np.zeros(n),
+                               poisson=np.zeros(n), knee=np.full(n, np.inf), rate=np.zeros(n), n_nodes=2,
+                               slack=np.full(n, delta))
+    return cyl, strain
+
+
+def test_a_slack_link_pushes_fully_and_its_pull_levels_off():
+    delta = 0.01
+    cyl, strain = _slack_links(delta)
+    e, de = elements.youngs_modulus(cyl, strain)
+    tension = e * strain * cyl.area0
+    full = cyl.youngs * cyl.area0
+    comp = strain <= 0
+    assert np.allclose(tension[comp], full[comp] * strain[comp])  # compression: the whole spring
+    assert np.all(np.diff(tension) >= -1e-9)  # monotone: no negative stiffness for Newton
+    assert np.allclose(tension[strain >= delta], full[0] * delta / 2)  # the pull's ceiling, E0 A d / 2
+    # the tangent the integrator uses is the derivative of the tension, across both joints (0 and d)
+    cs = elements.CylinderState(n=np.tile([1.0, 0, 0], (len(strain), 1)), length=cyl.l0 * (1 + strain),
+                                strain=strain, elastic=tension, shrink=np.ones_like(strain), e=e, de=de)
+    numeric = np.gradient(tension, strain * cyl.l0[0])
+    inner = (np.abs(strain) > 2e-3) & (np.abs(strain - delta) > 2e-3)
+    assert np.allclose(elements.axial_stiffness(cyl, cs)[inner], numeric[inner], rtol=1e-3, atol=1e-6 * full[0])
+
+
+def test_a_slack_link_gives_the_same_numbers_compiled_and_in_numpy_and_its_energy_integrates_its_tension():
+    cyl, strain = _slack_links(0.005)
+    x = np.zeros((2, 3))  # one link along x
+    for s in (-0.03, 0.002, 0.004, 0.02):
+        x[1] = [1.5 * (1 + s), 0, 0]
+        one = elements.CylinderSet(**{f: getattr(cyl, f)[:1] for f in ("i", "j", "l0", "area0", "youngs",
+                                                                      "viscosity", "poisson", "knee", "rate")},
+                                   n_nodes=2, slack=cyl.slack[:1])
+        a, b = elements.evaluate(one, x), elements.evaluate_numpy(one, x)
+        assert a.elastic == pytest.approx(b.elastic, rel=1e-12) and a.e == pytest.approx(b.e, rel=1e-12)
+        assert a.de == pytest.approx(b.de, rel=1e-12)
+    w = elements.strain_energy(cyl, strain)
+    e, _ = elements.youngs_modulus(cyl, strain)
+    tension = e * strain * cyl.area0
+    assert np.allclose(np.gradient(w, strain * cyl.l0[0])[1:-1], tension[1:-1], rtol=2e-3, atol=1e-3 * tension.max())
+
+
+def test_the_floor_links_go_slack_only_when_the_config_says_so(cfg, mesh, wall):
+    from artic_cli.geometry.anatomy import LINK_KINDS, build_body
+    from artic_cli.mechanics.model import build_articulator
+
+    n_floor = int((build_body(cfg, mesh).link_kind == LINK_KINDS.index("floor")).sum())
+    full = build_articulator(cfg, mesh, wall)
+    slack = build_articulator(cfg.model_copy(update={"jaw": cfg.jaw.model_copy(update={"floor_slack_strain": 0.005})}),
+                              mesh, wall)
+    assert np.isinf(full.springs.slack_strain).all() == (cfg.jaw.floor_slack_strain is None)
+    assert np.isfinite(slack.springs.slack_strain).sum() == n_floor > 0
+    assert np.allclose(slack.springs.slack_strain[np.isfinite(slack.springs.slack_strain)], 0.005)
