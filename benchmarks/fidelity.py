@@ -1,13 +1,14 @@
 """Fidelity scorecard: the muscles' behaviour against Dang & Honda (2004) for any config, in about 15 s.
 
-    python benchmarks/fidelity.py [CONFIG] [--parts k,dir,t3,fig4,jaw,fm]
+    python benchmarks/fidelity.py [CONFIG] [--parts k,dir,t3,fig4,jaw,fm,settle]
 
 k: SG alone at 0.5-4 N, jaw at rest: first dorsum-region contact and the dorsum's gap to the wall (cm);
 dir: the 16 definite directions of section IV.A.1 at 4 N (deg from the paper's; X: over 45 deg or a move
 under 0.05 cm); t3: Table III from the 6-N equilibria at the rest jaw, normalised by the largest single
 vector as the report does (GH included); k, dir and t3 hold the jaw when the config's epmap.hold_jaw says so; fig4: Table II peak speeds (SG 4 N + JO 3 N, 20 ms); jaw: the
-eight jaw EPs (cm); fm: F1-F3 (Hz) of the rest tract and of a few held muscle sets.  Not part of make
-bench (it measures behaviour, not speed).
+eight jaw EPs (cm); fm: F1-F3 (Hz) of the rest tract and of a few held muscle sets; settle: how many floor-muscle
+EPs (HG, GH, MH, GGp at 1-6 N) have not settled after the EP maps' hold, jaw free and held (not in the default
+parts).  Not part of make bench (it measures behaviour, not speed).
 """
 
 from __future__ import annotations
@@ -116,6 +117,22 @@ def formants(cfg, model, rest, audit) -> None:
         print(f"  {name}: F1-F3 {np.round(f).astype(int)} Hz, smallest area {amin:.2f} cm^2")
 
 
+def settling(cfg, model, rest) -> None:
+    """The floor muscles' EPs at the rest jaw, held as the EP maps hold them (epmap.duration_ms and its
+    settling test), with the jaw free and held: how many levels still move more than the tolerance."""
+    from artic_cli.control.equilibrium import equilibrium_point
+
+    for hold in (False, True):
+        spec = cfg.epmap.model_copy(update={"hold_jaw": hold})
+        cells, bad = [], 0
+        for m in ("HG", "GH", "MH", "GGp"):
+            drifts = [equilibrium_point(model, rest, {m: f}, spec).drift_cm for f in (1.0, 2.5, 4.0, 6.0)]
+            n = sum(d >= spec.convergence_tol_cm for d in drifts)
+            bad += n
+            cells.append(f"{m} {n} (worst {max(drifts):.3f} cm)")
+        print(f"  jaw {'held' if hold else 'free'}: unsettled of 4 levels: {', '.join(cells)}; {bad} of 16")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("config", nargs="?", default=None)
@@ -136,7 +153,9 @@ def main() -> None:
                            ("t3", "Table III (6 N, rest jaw)", lambda: table_iii(rest, audit, pts, hold)),
                            ("fig4", "Table II", lambda: fig4(rest, audit, pts)),
                            ("jaw", "jaw EPs", lambda: jaw_eps(rest, audit, pts)),
-                           ("fm", "formants", lambda: formants(cfg, model, rest, audit))):
+                           ("fm", "formants", lambda: formants(cfg, model, rest, audit)),
+                           ("settle", "settling after epmap.duration_ms (cm moved over the last window)",
+                            lambda: settling(cfg, model, rest))):
         if key in parts:
             print(title)
             fn()
