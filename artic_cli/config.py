@@ -394,6 +394,10 @@ class Speech(Strict):
     """How an utterance is spoken (``artic speak``): the force course, the glottis and the lungs."""
 
     ramp_ms: Annotated[float, Field(ge=0, le=500, allow_inf_nan=False)] = 30.0  # each target's forces ramp in over this
+    # the muscles' force follows the course with first-order activation dynamics, rising and falling with these
+    # time constants (beyond the paper, whose forces follow their commands at once: 0, 0)
+    activation_rise_ms: Annotated[float, Field(ge=0, le=200, allow_inf_nan=False)] = 0.0
+    activation_fall_ms: Annotated[float, Field(ge=0, le=200, allow_inf_nan=False)] = 0.0
     lip_ramp_ms: Annotated[float, Field(ge=0, le=500, allow_inf_nan=False)] = 60.0  # the lips and velum move over this
     voicing_ramp_ms: Annotated[float, Field(ge=1, le=200, allow_inf_nan=False)] = 20.0  # voice on / off
     lung_pressure_kpa: Annotated[float, Field(gt=0, le=4, allow_inf_nan=False)] = 0.8  # 8 cm H2O, speech at normal effort

@@ -2,7 +2,8 @@
 
 As the paper's controller does, a target's forces act "constantly until a new target is coming": at each
 start the forces move from the values reached so far to the new set along a raised cosine over ``ramp_s``,
-then hold.  Vectors are any unit (the stage passes muscle-unit forces in dyn).
+then hold.  Vectors are any unit (the stage passes muscle-unit forces in dyn).  :func:`activated` lets a
+muscle's force follow such a course with first-order activation dynamics (beyond the paper).
 """
 
 from __future__ import annotations
@@ -53,3 +54,26 @@ def pulse_step(starts_s, durations_s, vectors, pulse_s: float, gain: float, uppe
         sets += [np.clip(f + gain * (f - before), 0.0, upper), f]
         before = f
     return np.array(starts), np.array(sets)
+
+
+def activated(force_at, duration_s: float, rise_s: float, fall_s: float, step_s: float = 5e-4):
+    """``g(t) -> (M,)``: each component of ``force_at`` through first-order activation dynamics, a force that
+    rises toward its command with time constant ``rise_s`` and falls with ``fall_s`` (Zajac 1989's
+    excitation-contraction lag), from the command just before t = 0; exact exponential steps of ``step_s`` on
+    a grid, linear between them."""
+    t = np.arange(0.0, duration_s + 2 * step_s, step_s)
+    out = np.empty((len(t), len(np.atleast_1d(force_at(0.0)))))
+    out[0] = force_at(-step_s)
+    up, down = (np.exp(-step_s / tau) if tau > 0 else 0.0 for tau in (rise_s, fall_s))
+    for k in range(1, len(t)):
+        u = force_at(t[k] - 0.5 * step_s)
+        keep = np.where(u > out[k - 1], up, down)
+        out[k] = u + (out[k - 1] - u) * keep
+
+    def at(time: float) -> np.ndarray:
+        x = np.clip(time, t[0], t[-1]) / step_s
+        k = min(int(x), len(t) - 2)
+        w = x - k
+        return out[k] * (1.0 - w) + out[k + 1] * w
+
+    return at

@@ -396,13 +396,19 @@ def utterance_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row
 
     out_dir = Path("reports") if out_dir is None else out_dir
     rows: list[Row] = []
+    paths = sorted((data / "utterances").glob("*.h5"))
+    first = speak_stage.read(paths[0]) if paths else None
+    ramp = f"{first.ramp_ms:g} ms" if first else "the configured ramp"
+    rise, fall = first.activation_ms if first else (0.0, 0.0)
+    lag = (f", the muscles following them through first-order activation dynamics ({rise:g} ms rising, {fall:g} ms "
+           "falling; the paper's forces follow at once)") if rise > 0 or fall > 0 else ""
     lines = ["Each utterance is a list of targets with durations (`configs/utterances/`), spoken by `artic speak "
-             "--accept-nearest`: every target solved once, its forces ramped in over 30 ms at its segment's start "
-             "and held (the paper's static forces), the whole simulated with contact, then tract, formants and "
+             f"--accept-nearest`: every target solved once, its forces ramped in over {ramp} at its segment's start "
+             f"and held (the paper's static forces){lag}, the whole simulated with contact, then tract, formants and "
              "sound (LF voice, off in voiceless segments; turbulence noise at the narrowest place).  Formants are "
              "our transfer function's, medians over each segment's middle half.", ""]
     pictures: list[str] = []
-    for path in sorted((data / "utterances").glob("*.h5")):
+    for path in paths:
         rec = speak_stage.read(path)
         wav = path.with_suffix(".wav")
         y, rate = read_wav(wav)

@@ -25,7 +25,7 @@ from .. import units
 from ..acoustics.aerodynamics import turbulence
 from ..acoustics.tube import Tube
 from ..config import Config, load_config
-from ..control.course import course, pulse_step
+from ..control.course import activated, course, pulse_step
 from ..control.solver import TargetSpec, parse_target
 from ..control.targets import load_target
 from ..errors import ArticError, NotPhysical, UnreachableTarget
@@ -76,11 +76,13 @@ class Spoken:
     audio: syn_stage.Audio
     control_points: dict[str, np.ndarray]  # (F, 3) cm
     muscle_names: list[str]
-    muscle_force_n: np.ndarray  # (F, M) commanded
+    muscle_force_n: np.ndarray  # (F, M) commanded: the course, after activation dynamics when they are on
     timings_s: dict[str, float]  # wall time of each part: rest, simulation, tract, formants, sound
     segment_eps_cm: np.ndarray  # (K, 3, 3) tip, dorsum, jaw where each segment's forces lead (held from rest)
     beyond_wall_cm: float  # the farthest any tongue node got beyond the wall
     force_course: str  # static or pulse_step
+    ramp_ms: float  # each segment's ramp
+    activation_ms: tuple[float, float]  # the muscles' activation rise and fall time constants (0, 0: none)
 
 
 # --- the plan: targets -> forces ---------------------------------------------------------------------
@@ -280,6 +282,10 @@ def compute(u: Utterance, p: Plan, cfg: Config, mesh, wall, progress=None, model
         starts, sets = pulse_step(p.starts_s, p.durations_s, vectors, units.ms_to_s(sp.pulse_ms), sp.pulse_gain,
                                   units.newton_to_dyn(view.muscles.max_force_n))
     force_at = course(starts, sets, ramp_s)
+    duration = float(p.starts_s[-1] + p.durations_s[-1])
+    if sp.activation_rise_ms > 0 or sp.activation_fall_ms > 0:
+        force_at = activated(force_at, duration, units.ms_to_s(sp.activation_rise_ms),
+                             units.ms_to_s(sp.activation_fall_ms))
     zero = np.zeros((model.n_nodes, 3))
     clock = [time.perf_counter()]
     timings: dict[str, float] = {}
@@ -293,7 +299,6 @@ def compute(u: Utterance, p: Plan, cfg: Config, mesh, wall, progress=None, model
     lap("rest posture")
     eps = equilibria(model, start, vectors, units.ms_to_s(sp.reach_hold_ms), units.ms_to_s(view.simulation.dt_ms))
     lap("segment EPs")
-    duration = float(p.starts_s[-1] + p.durations_s[-1])
     dt = units.ms_to_s(view.simulation.dt_ms)
     every = max(1, int(round(units.ms_to_s(sp.frame_ms) / dt)))
     traj, _ = run(model, start, lambda t: Control(node_force=zero, muscle_force=force_at(t)), duration, dt,
@@ -350,7 +355,8 @@ def compute(u: Utterance, p: Plan, cfg: Config, mesh, wall, progress=None, model
                   glottis_cm2=glottis, audio=audio, control_points=cps, muscle_names=list(model.muscle_names),
                   muscle_force_n=units.dyn_to_newton(commanded), timings_s=timings, segment_eps_cm=eps,
                   beyond_wall_cm=beyond,
-                  force_course=how)
+                  force_course=how, ramp_ms=units.s_to_ms(ramp_s),
+                  activation_ms=(sp.activation_rise_ms, sp.activation_fall_ms))
 
 
 # --- files ---------------------------------------------------------------------------------------------
@@ -399,6 +405,8 @@ def write(wav: Path | str, s: Spoken, prov=None) -> dict[str, Path]:
         g.create_dataset("ep", data=s.segment_eps_cm).attrs["units"] = ("cm: tip, dorsum, jaw where each segment's "
                                                                         "forces lead (held from rest, jaw free)")
         g.attrs["force_course"] = s.force_course
+        g.attrs["ramp_ms"] = s.ramp_ms
+        g.attrs["activation_ms"] = np.asarray(s.activation_ms, float)
         g.create_dataset("lip_area", data=np.array([a for a, _ in p.lips])).attrs["units"] = "cm^2"
         g.create_dataset("lip_length", data=np.array([b for _, b in p.lips])).attrs["units"] = "cm"
         names = sorted({m for f_ in p.forces_n for m in f_})
@@ -457,6 +465,8 @@ class Record:
     eps_cm: np.ndarray  # (K, 3, 3)
     commanded_n: np.ndarray  # (F, M)
     force_course: str
+    ramp_ms: float
+    activation_ms: tuple[float, float]
 
 
 def read(path: Path | str) -> Record:
@@ -471,7 +481,9 @@ def read(path: Path | str) -> Record:
                           length_cm=f["area_function/length"][()], noise_rms=f["aerodynamics/noise_rms"][()],
                           positions_cm=f["positions"][()], volume_change=f["volume_change"][()],
                           eps_cm=g["ep"][()], commanded_n=f["muscles/commanded"][()],
-                          force_course=str(g.attrs.get("force_course", "static")))
+                          force_course=str(g.attrs.get("force_course", "static")),
+                          ramp_ms=float(g.attrs.get("ramp_ms", 30.0)),
+                          activation_ms=tuple(float(v) for v in g.attrs.get("activation_ms", (0.0, 0.0))))
         except (KeyError, ValueError, OSError) as err:
             raise ArticError(f"{path} is damaged or incomplete ({type(err).__name__}); {STAGE.hint}") from None
 

@@ -151,6 +151,20 @@ def test_a_narrow_channel_makes_frication_that_the_noise_switch_removes(spoken, 
     assert seg["f"]["level_above_3khz_db"] > seg["a"]["level_above_3khz_db"]
 
 
+def test_activation_dynamics_lag_the_course_by_their_time_constants():
+    from artic_cli.control.course import activated
+
+    step = course([0.0, 0.2], np.array([[2.0], [0.0]]), 0.0)  # a force step on at 0 and off at 200 ms
+    g = activated(step, 0.4, 0.015, 0.04)
+    assert float(g(0.015)[0]) == pytest.approx(2.0 * (1 - np.exp(-1)), rel=0.02)  # rises with 15 ms
+    assert float(g(0.24)[0]) == pytest.approx(float(g(0.2)[0]) * np.exp(-1), rel=0.02)  # falls with 40 ms
+    t = np.linspace(0.0, 0.4, 401)
+    vals = np.array([float(g(x)[0]) for x in t])
+    assert vals.min() >= -1e-12 and vals.max() <= 2.0 + 1e-12  # never beyond the commands
+    same = activated(step, 0.4, 0.0, 0.0)
+    assert all(float(same(x)[0]) == pytest.approx(float(step(x)[0])) for x in (0.05, 0.19, 0.21, 0.3))
+
+
 def test_a_pulse_step_course_opens_each_segment_with_a_clipped_pulse():
     from artic_cli.control.course import pulse_step
 
