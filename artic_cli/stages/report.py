@@ -449,7 +449,10 @@ def utterance_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row
             rows.append(Row("/asa/: level above 3 kHz, /s/ against the vowels", ">= +20 dB (goal)", f"{hf:+.1f} dB",
                             _verdict(bool(hf >= 20), "frication")))
         if name.startswith("aia"):
-            t90 = "; ".join(f"{s['label']} " + " / ".join(f"{s.get(f'{c}_t90_ms', np.nan):.0f}" for c in
+            def ms(v: float) -> str:
+                return f"{v:.0f}" if np.isfinite(v) else "not in the segment"
+
+            t90 = "; ".join(f"{s['label']} " + " / ".join(ms(s.get(f'{c}_t90_ms', np.nan)) for c in
                                                            ("tip", "dorsum", "jaw")) for s in m["segments"])
             lines.append(f"  * {m['force_course']} forces: time to cover 90 % of the way to each segment's EP "
                          f"(tip / dorsum / jaw, ms): {t90}; commanded force impulse {m['force_impulse_n_s']:.2f} "
