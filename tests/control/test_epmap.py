@@ -20,7 +20,7 @@ from conftest import ROOT
 
 def _config(tmp_path, name: str, **epmap) -> str:
     d = yaml.safe_load((ROOT / "configs" / "default.yaml").read_text())
-    d["epmap"] = epmap
+    d["epmap"] = {"hold_jaw": d.get("epmap", {}).get("hold_jaw", False), **epmap}  # the jaw held as the maps hold it
     path = tmp_path / f"{name}.yaml"
     path.write_text(yaml.safe_dump(d, sort_keys=False))
     return str(path)

@@ -127,10 +127,10 @@ def fig4_rows(art):
     return {r.name: r for r in fig4(art)}
 
 
-def test_fig4_sg_peak_speeds_within_a_factor_of_two_of_table_ii(fig4_rows):
-    for cp in ("tip", "dorsum"):
+def test_fig4_sg_peak_speeds_within_25_percent_of_table_ii(fig4_rows):
+    for cp in ("tip", "dorsum", "jaw"):  # the goal
         r = fig4_rows[f"SG+JO {cp} peak speed"]
-        assert 0.5 <= r.ours / r.paper <= 2.0, r
+        assert abs(r.ours / r.paper - 1) <= 0.25, r
 
 
 def _audit(rows):
@@ -161,13 +161,12 @@ def directions(art, cfg):
     return {r.name: r for r in muscle_directions(art, hold=cfg.epmap.hold_jaw)}  # held as the EP maps hold it
 
 
-AGREE = [("GGa", "tip"), ("GGm", "tip"), ("GGm", "dorsum"), ("GGp", "dorsum"), ("HG", "tip"), ("HG", "dorsum"),
+AGREE = [("GGa", "tip"), ("GGm", "tip"), ("GGm", "dorsum"), ("GGp", "tip"), ("GGp", "dorsum"), ("HG", "tip"),
+         ("HG", "dorsum"),
          ("SG", "tip"), ("SG", "dorsum"), ("SL", "tip"), ("SL", "dorsum"), ("IL", "tip"), ("V", "tip"),
          ("V", "dorsum"), ("MH", "dorsum")]
-KNOWN = {("GGp", "tip"): "GGp pulls the root forward and the blunt 2-cm tip slides forward and down (60 deg from "
-                         "forward-up) about the GG tendon, a rigid inner arc carried by the jaw",
-         ("IL", "dorsum"): "in a radial fan centred on the GG origin the tongue's lower side is a short arc around "
-                           "the origin; IL pulls the dorsum back-down toward it (73 deg from back-up)"}
+KNOWN = {("IL", "dorsum"): "in a radial fan centred on the GG origin the tongue's lower side is a short arc around "
+                           "the origin; IL pulls the dorsum back-down toward it (76 deg from back-up)"}
 
 
 def _angle(row) -> float:
