@@ -396,8 +396,8 @@ def utterance_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row
 
     out_dir = Path("reports") if out_dir is None else out_dir
     rows: list[Row] = []
-    paths = sorted((data / "utterances").glob("*.h5"))
-    first = speak_stage.read(paths[0]) if paths else None
+    records = [(path, speak_stage.read(path)) for path in sorted((data / "utterances").glob("*.h5"))]
+    first = records[0][1] if records else None
     ramp = f"{first.ramp_ms:g} ms" if first else "the configured ramp"
     rise, fall = first.activation_ms if first else (0.0, 0.0)
     lag = (f", the muscles following them through first-order activation dynamics ({rise:g} ms rising, {fall:g} ms "
@@ -408,8 +408,7 @@ def utterance_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row
              "sound (LF voice, off in voiceless segments; turbulence noise at the narrowest place).  Formants are "
              "our transfer function's, medians over each segment's middle half.", ""]
     pictures: list[str] = []
-    for path in paths:
-        rec = speak_stage.read(path)
+    for path, rec in records:
         wav = path.with_suffix(".wav")
         y, rate = read_wav(wav)
         m = speak_stage.measures(rec, y, rate)
