@@ -173,6 +173,9 @@ class EPMapSpec(Strict):
     convergence_window_ms: Positive = 50.0
     convergence_tol_cm: Positive = 0.01  # converged: control points moved less than this over the last window
     early_stop_tol_cm: Positive = 0.002  # --fast: stop once they move less than this over a window
+    # an EP still moving after duration_ms is held on for up to this long, stopping once it has settled
+    # (0: the paper's fixed hold)
+    extend_ms: NonNeg = 0.0
     # the mandible held where the jaw position's rest has it while tongue muscles act (the paper: jaw forces
     # held, the jaw free); also the muscle directions and k-closure experiments
     hold_jaw: bool = False

@@ -19,7 +19,7 @@ from ..geometry.wall import WallSurface
 from ..mechanics.jaw_hold import fresh_start, hold_jaw
 from ..mechanics.loads import muscle_force_vector
 from ..mechanics.model import ARTICULATOR_SECTIONS, Control, Model, State, build_articulator
-from ..mechanics.simulate import equilibrate, hold, settle
+from ..mechanics.simulate import Hold, equilibrate, hold, settle
 
 Forces = tuple[tuple[str, float], ...]
 
@@ -65,13 +65,19 @@ def jaw_rest(model: Model, jaw_forces: dict[str, float]) -> State:
 
 def equilibrium_state(model: Model, start: State, forces_n: dict[str, float], spec: EPMapSpec,
                       fast: bool = False) -> tuple[State, EP]:
-    """Hold the forces for ``spec.duration_ms`` (``fast``: stop once settled): the whole final state and the
-    EP read from it."""
+    """Hold the forces for ``spec.duration_ms`` (``fast``: stop once settled; still moving then: up to
+    ``spec.extend_ms`` more, stopping once settled): the whole final state and the EP read from it."""
     if spec.hold_jaw:  # the jaw position's mandible stays where the start has it
         model, start = hold_jaw(model, start.x), fresh_start(start)
-    h = hold(model, start, control_for(model, forces_n), units.ms_to_s(spec.duration_ms), watch_nodes(model),
-             units.ms_to_s(spec.convergence_window_ms), stop_below=spec.early_stop_tol_cm if fast else None)
-    return h.state, EP(x=h.state.x[watch_nodes(model)].copy(), drift_cm=h.drift,
+    control, watch = control_for(model, forces_n), watch_nodes(model)
+    window = units.ms_to_s(spec.convergence_window_ms)
+    h = hold(model, start, control, units.ms_to_s(spec.duration_ms), watch, window,
+             stop_below=spec.early_stop_tol_cm if fast else None)
+    if spec.extend_ms > 0 and not h.drift < spec.convergence_tol_cm:  # still moving: hold on until settled
+        more = hold(model, h.state, control, units.ms_to_s(spec.extend_ms), watch, window,
+                    stop_below=spec.convergence_tol_cm)
+        h = Hold(state=more.state, drift=more.drift, stopped=h.stopped + more.stopped)
+    return h.state, EP(x=h.state.x[watch].copy(), drift_cm=h.drift,
                        converged=bool(h.drift < spec.convergence_tol_cm), stopped_ms=units.s_to_ms(h.stopped))
 
 
@@ -128,4 +134,6 @@ def spec_key(spec: EPMapSpec) -> str:
                                           "early_stop_tol_cm")}
     if spec.hold_jaw:
         keep["hold_jaw"] = True
+    if spec.extend_ms > 0:
+        keep["extend_ms"] = spec.extend_ms
     return json.dumps(keep, sort_keys=True)

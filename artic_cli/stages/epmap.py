@@ -116,7 +116,8 @@ def build_ep_maps(mesh: Path | str = "data/mesh.h5", config: Path | str | None =
 def write(path: Path | str, maps: EPMaps, cfg: Config, prov=None, fast: bool = False) -> None:
     with atomic_h5(path, "epmap", prov) as f:
         f.attrs.update({"method": "dynamic, stopped once settled" if fast else "dynamic, full duration",
-                        "duration_ms": cfg.epmap.duration_ms, "typical_jaw": maps.typical_jaw,
+                        "duration_ms": cfg.epmap.duration_ms, "extend_ms": cfg.epmap.extend_ms,
+                        "typical_jaw": maps.typical_jaw,
                         "control_points": list(CONTROL_POINTS), "spec_json": json.dumps(cfg.epmap.model_dump(mode="json")),
                         "units": "positions in cm (x anterior, y superior, z left), forces in N",
                         "layout": "jaw_positions/<jaw>/{rest, single/<muscle>, pair/<a+b>, group/<i+a+b>}: "

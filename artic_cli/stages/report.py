@@ -25,6 +25,11 @@ class Row:
     verdict: str
 
 
+def _extension(attrs) -> str:
+    ext = float(attrs.get("extend_ms", 0.0))
+    return f" and up to {ext:g} ms more" if ext > 0 else ""
+
+
 def _verdict(ok: bool, detail: str) -> str:
     return ("agrees" if ok else "differs") + f" ({detail})"
 
@@ -201,7 +206,7 @@ def map_rows(data: Path) -> tuple[list[Row], list[str]]:
     unsettled = sum(int((~n.converged).sum()) for jm in maps.jaws.values() for fam in (jm.single, jm.pair, jm.group)
                     for n in fam.values())
     rows.append(Row(f"EP maps: {len(maps.jaws)} jaw positions, {n_eps} EPs (with shared axes)", "nine jaw positions",
-                    f"{unsettled} not settled in {maps.attrs.get('duration_ms', 300):g} ms (flagged, not used)",
+                    f"{unsettled} not settled in {maps.attrs.get('duration_ms', 300):g} ms{_extension(maps.attrs)} (flagged, not used)",
                     _verdict(unsettled <= 0.02 * n_eps, "goal: flagged, at most 2 %")))
     jaw = "rest" if "rest" in maps.jaws else maps.typical_jaw
     c = contribution_factors(maps, jaw)

@@ -224,3 +224,18 @@ def test_an_interrupted_build_resumes_from_the_finished_equilibria(tmp_path, mes
     res = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=ROOT, timeout=300)
     assert res.returncode == 0, res.stderr
     assert f"13 equilibria ({13 - done} computed, {done} from the cache)" in " ".join(res.stdout.split())
+
+
+def test_an_ep_still_moving_is_held_on_until_it_settles(art, cfg):
+    from artic_cli.control.equilibrium import equilibrium_point
+    from artic_cli.mechanics.simulate import settle
+
+    rest = settle(art)
+    short = cfg.epmap.model_copy(update={"duration_ms": 60.0, "extend_ms": 0.0})
+    cut = equilibrium_point(art, rest, {"GGp": 4.0}, short)
+    assert not cut.converged and cut.stopped_ms == pytest.approx(60.0)
+    held_on = equilibrium_point(art, rest, {"GGp": 4.0}, short.model_copy(update={"extend_ms": 540.0}))
+    assert held_on.converged and held_on.drift_cm < short.convergence_tol_cm
+    assert 60.0 + short.convergence_window_ms <= held_on.stopped_ms < 600.0  # stopped once settled, not at the end
+    full = equilibrium_point(art, rest, {"GGp": 4.0}, short.model_copy(update={"duration_ms": 600.0}))
+    assert np.abs(held_on.x - full.x).max() < 2 * short.convergence_tol_cm
