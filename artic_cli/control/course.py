@@ -59,8 +59,8 @@ def pulse_step(starts_s, durations_s, vectors, pulse_s: float, gain: float, uppe
 def activated(force_at, duration_s: float, rise_s: float, fall_s: float, step_s: float = 5e-4):
     """``g(t) -> (M,)``: each component of ``force_at`` through first-order activation dynamics, a force that
     rises toward its command with time constant ``rise_s`` and falls with ``fall_s`` (the excitation-contraction
-    lag of Zajac 1989; the default speaker takes Thelen 2003's 15 / 50 ms), from the command just before t = 0; exact exponential steps of ``step_s`` on
-    a grid, linear between them."""
+    lag of Zajac 1989; the default speaker takes Thelen 2003's 15 / 50 ms), from the command just before
+    t = 0; exact exponential steps of ``step_s`` on a grid, linear between them."""
     t = np.arange(0.0, duration_s + 2 * step_s, step_s)
     out = np.empty((len(t), len(np.atleast_1d(force_at(0.0)))))
     out[0] = force_at(-step_s)

@@ -205,8 +205,9 @@ def map_rows(data: Path) -> tuple[list[Row], list[str]]:
                 for n in fam.values())
     unsettled = sum(int((~n.converged).sum()) for jm in maps.jaws.values() for fam in (jm.single, jm.pair, jm.group)
                     for n in fam.values())
+    held = f"{maps.attrs.get('duration_ms', 300):g} ms{_extension(maps.attrs)}"
     rows.append(Row(f"EP maps: {len(maps.jaws)} jaw positions, {n_eps} EPs (with shared axes)", "nine jaw positions",
-                    f"{unsettled} not settled in {maps.attrs.get('duration_ms', 300):g} ms{_extension(maps.attrs)} (flagged, not used)",
+                    f"{unsettled} not settled in {held} (flagged, not used)",
                     _verdict(unsettled <= 0.02 * n_eps, "goal: flagged, at most 2 %")))
     jaw = "rest" if "rest" in maps.jaws else maps.typical_jaw
     c = contribution_factors(maps, jaw)
