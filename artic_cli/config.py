@@ -75,6 +75,9 @@ class TissueMaterial(Strict):
     stiffening_rate: NonNeg = 0.0
     isotropic_truss: bool = True
     volume_constraint_gain: Annotated[float, Field(ge=1.0, le=1000.0)] = 1.0
+    # the drawn rest shape carries the tongue's weight (cylinder rest lengths prestrained; false: the paper's
+    # stress-free rest, which gravity sags before any muscle acts)
+    rest_under_gravity: bool = False
 
 
 class BoneMaterial(Strict):

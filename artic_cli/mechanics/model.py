@@ -33,6 +33,7 @@ from .contact import ContactModel, contact_model
 from .elements import CylinderSet
 from .isotropy import isotropic_areas
 from .muscles import MuscleSet, muscle_set
+from .prestress import weight_carrying
 
 
 
@@ -221,6 +222,19 @@ def tongue_cylinders(mesh: Mesh, tissue: TissueMaterial, n_nodes: int) -> tuple[
     return cyl, scale, bulk_ratio
 
 
+def _carrying_weight(cyl: CylinderSet, x: np.ndarray, tissue: TissueMaterial, mesh: Mesh, gravity: float,
+                     free: np.ndarray, carriers: np.ndarray) -> CylinderSet:
+    """The cylinders as they are, or (``tissue.rest_under_gravity``) with the rest lengths of the
+    ``carriers`` (the tongue's cylinders, and the floor's links in the articulator) set to carry the weight
+    of the ``free`` tongue nodes at their drawn positions ``x``."""
+    if not tissue.rest_under_gravity or gravity == 0.0:
+        return cyl
+    nt = len(mesh.cylinders)
+    m = tissue.density_g_cm3 * mesh.areas * cyl.l0[:nt]
+    node_mass = np.bincount(cyl.i[:nt], m / 2, cyl.n_nodes) + np.bincount(cyl.j[:nt], m / 2, cyl.n_nodes)
+    return weight_carrying(cyl, x, node_mass, np.array([0.0, -gravity, 0.0]), free, carriers)
+
+
 def _consistent_mass(i, j, m, n):
     rows = np.concatenate([i, j, i, j])
     cols = np.concatenate([i, j, j, i])
@@ -285,12 +299,15 @@ def build_model(mesh: Mesh, tissue: TissueMaterial, sim: Simulation, *,
             fixed_dofs[mesh.node_sets[name]] = True
     link_mass = tissue.density_g_cm3 * mesh.areas * cyl.l0  # the paper's volumes carry the mass
     g = sim.gravity_cm_s2 if gravity is None else gravity
+    cyl = _carrying_weight(cyl, mesh.nodes, tissue, mesh, g, np.where(~fixed_dofs.all(axis=1))[0],
+                           np.ones(len(cyl), dtype=bool))
     return _finish(mesh, mesh.nodes.copy(), cyl, link_mass, kappa, fixed_dofs, sim, g, n,
                    bulk_ratio * scale * e0, node_sets=dict(mesh.node_sets))
 
 
-def _links(body: Body, cfg: Config, tissue_scale: float) -> tuple[CylinderSet, np.ndarray]:
-    """Passive links of the articulator: bones, floor, straps, jaw muscles' passive springs."""
+def _links(body: Body, cfg: Config, tissue_scale: float) -> tuple[CylinderSet, np.ndarray, np.ndarray]:
+    """Passive links of the articulator: bones, floor, straps, jaw muscles' passive springs; their masses
+    and kinds (an index of LINK_KINDS, -1 for the jaw muscles' springs)."""
     jaw = cfg.jaw
     bone = cfg.materials.bone
     tissue = cfg.materials.tongue
@@ -331,7 +348,7 @@ def _links(body: Body, cfg: Config, tissue_scale: float) -> tuple[CylinderSet, n
         slack[floor] = jaw.floor_slack_strain
     cyl = CylinderSet(i=i, j=j, l0=l0, area0=area, youngs=e, viscosity=eta, poisson=np.zeros(n),
                       knee=np.full(n, np.inf), rate=np.zeros(n), n_nodes=len(x), slack=slack)
-    return cyl, mass
+    return cyl, mass, kinds
 
 
 def _concat(a: CylinderSet, b: CylinderSet) -> CylinderSet:
@@ -354,9 +371,12 @@ def build_articulator(cfg: Config, mesh: Mesh, wall: WallSurface | None = None, 
     n = len(body.nodes)
     tissue = cfg.materials.tongue
     tcyl, scale, bulk_ratio = tongue_cylinders(mesh, tissue, n)
-    lcyl, lmass = _links(body, cfg, scale)
-    cyl = _concat(tcyl, lcyl)
+    lcyl, lmass, lkind = _links(body, cfg, scale)
     link_mass = np.concatenate([tissue.density_g_cm3 * mesh.areas * tcyl.l0, lmass])
+    grav = cfg.simulation.gravity_cm_s2 if gravity is None else gravity
+    free = np.setdiff1d(np.arange(len(mesh.nodes)), body.carried)  # the tongue but its GG tendon on the mandible
+    carriers = np.r_[np.ones(len(tcyl), dtype=bool), lkind == LINK_KINDS.index("floor")]
+    cyl = _carrying_weight(_concat(tcyl, lcyl), body.nodes, tissue, mesh, grav, free, carriers)
     on = cfg.simulation.volume_constraint if volume_constraint is None else volume_constraint
     e0 = units.kpa_to_cgs(tissue.youngs_modulus_kpa)
     kappa = np.full(len(mesh.bricks), bulk_ratio * scale * e0 if on else 0.0)
@@ -395,14 +415,13 @@ def build_articulator(cfg: Config, mesh: Mesh, wall: WallSurface | None = None, 
                                                       "condyle_l")])
         cm = contact_model(wall, nodes, mesh.nodes[nodes], jaw_frame, body.nodes[jaw_frame],
                            units.newton_to_dyn(cfg.contact.stiffness_n_per_cm), cfg.contact.tolerance_cm)
-    g = cfg.simulation.gravity_cm_s2 if gravity is None else gravity
     tone = np.zeros(len(names))
     for name, fn in mc.postural_tone_n.items():
         members = mc.groups.get(name, {name: 1.0})
         check_muscle_names(members, names, "muscles.postural_tone_n")
         for m, w in members.items():
             tone[names.index(m)] += units.newton_to_dyn(fn) * w
-    return _finish(mesh, body.nodes.copy(), cyl, link_mass, kappa, fixed, cfg.simulation, g, len(mesh.nodes),
+    return _finish(mesh, body.nodes.copy(), cyl, link_mass, kappa, fixed, cfg.simulation, grav, len(mesh.nodes),
                    bulk_ratio * scale * e0,
                    node_sets=dict(body.node_sets), names=dict(body.names), muscles=ms,
                    groups={k: dict(v) for k, v in mc.groups.items()}, guide_spec=guide, contact=cm, wall=wall,
