@@ -2,11 +2,12 @@
 
 A speaker's rest outline (MRI, or the default speaker's drawing) is the tongue as it hangs in the head, its
 weight already carried by the tissue.  Taken as stress-free, gravity sags it again before any muscle acts.
-``gravity_rest_lengths`` shortens (or lengthens) each tongue cylinder so that at the drawn positions the
-cylinders' tensions balance every free node's weight exactly; the supports (the nodes held by the mandible
-and the floor resting on the hyoid) pass the weight on.  Among all such tension sets it takes the one of
-least elastic energy, sum t^2 / k: the tensions a linear truss develops when the load is applied to it,
-t = K A^T (A K A^T)^-1 b, with A the nodes' equilibrium operator and K the cylinders' axial stiffnesses.
+``weight_carrying`` shortens (or lengthens) each carrying cylinder (the tongue's, and in the articulator
+the floor's links to the hyoid) so that at the drawn positions their tensions balance every free node's
+weight exactly; the supports (the nodes the mandible carries, the hyoid) pass the weight on.  Among all
+such tension sets it takes the one of least elastic energy, sum t^2 / k: the tensions a linear truss
+develops when the load is applied to it, t = K A^T (A K A^T)^-1 b, with A the nodes' equilibrium operator
+and K the cylinders' axial stiffnesses.
 """
 
 from __future__ import annotations
