@@ -297,6 +297,8 @@ def build_model(mesh: Mesh, tissue: TissueMaterial, sim: Simulation, *,
                 valid = ", ".join(sorted(mesh.node_sets))
                 raise ArticError(f"unknown fixed node set '{name}'; valid sets: {valid}")
             fixed_dofs[mesh.node_sets[name]] = True
+        if sim.midsagittal_symmetry:  # the midsagittal nodes stay in their plane (no sideways buckling)
+            fixed_dofs[mesh.node_sets["midsagittal"], 2] = True
     link_mass = tissue.density_g_cm3 * mesh.areas * cyl.l0  # the paper's volumes carry the mass
     g = sim.gravity_cm_s2 if gravity is None else gravity
     cyl = _carrying_weight(cyl, mesh.nodes, tissue, mesh, g, np.where(~fixed_dofs.all(axis=1))[0],
@@ -382,7 +384,7 @@ def build_articulator(cfg: Config, mesh: Mesh, wall: WallSurface | None = None, 
     kappa = np.full(len(mesh.bricks), bulk_ratio * scale * e0 if on else 0.0)
     fixed = np.zeros((n, 3), dtype=bool)
     fixed[body.fixed] = True
-    if cfg.simulation.midsagittal_symmetry:  # the midsagittal nodes stay in their plane (the carried ones follow the jaw)
+    if cfg.simulation.midsagittal_symmetry:  # the midsagittal nodes stay in their plane (carried ones follow the jaw)
         fixed[np.setdiff1d(mesh.node_sets["midsagittal"], body.carried), 2] = True
 
     mc = cfg.muscles
