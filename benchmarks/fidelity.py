@@ -7,8 +7,10 @@ dir: the 16 definite directions of section IV.A.1 at 4 N (deg from the paper's; 
 under 0.05 cm); t3: Table III from the 6-N equilibria at the rest jaw, normalised by the largest single
 vector as the report does (GH included); k, dir and t3 hold the jaw when the config's epmap.hold_jaw says so; fig4: Table II peak speeds (SG 4 N + JO 3 N, 20 ms); jaw: the
 eight jaw EPs (cm); fm: F1-F3 (Hz) of the rest tract and of a few held muscle sets; settle: how many floor-muscle
-EPs (HG, GH, MH, GGp at 1-6 N) have not settled after the EP maps' hold, jaw free and held (not in the default
-parts).  Not part of make bench (it measures behaviour, not speed).
+EPs (HG, GH, MH, GGp at 1-6 N) have not settled after the EP maps' hold, jaw free and held; hold300: the same
+muscles at every map level with the jaw held and the paper's fixed 300-ms hold (what the EP-map tests assert);
+fig7: Fig. 7's worst end-point spread (goal 0.05 cm); stress: the 7-N run's volume change (goal 0.3 %); the last
+four are not in the default parts.  Not part of make bench (it measures behaviour, not speed).
 """
 
 from __future__ import annotations
@@ -133,6 +135,33 @@ def settling(cfg, model, rest) -> None:
         print(f"  jaw {'held' if hold else 'free'}: unsettled of 4 levels: {', '.join(cells)}; {bad} of 16")
 
 
+def fixed_hold(cfg, model, rest) -> None:
+    """Every map level of the floor muscles, the jaw held, the paper's fixed hold (no extension)."""
+    from artic_cli.control.equilibrium import equilibrium_point
+
+    spec = cfg.epmap.model_copy(update={"hold_jaw": True, "extend_ms": 0.0})
+    bad = 0
+    for m in ("HG", "GH", "MH", "GGp"):
+        drifts = {f: equilibrium_point(model, rest, {m: f}, spec).drift_cm for f in spec.levels_n if f > 0}
+        late = {f: d for f, d in drifts.items() if d >= spec.convergence_tol_cm}
+        bad += len(late)
+        print(f"  {m}: " + " ".join(f"{f:g} N {d:.4f}{'*' if f in late else ''}" for f, d in drifts.items()))
+    print(f"  unsettled after {spec.duration_ms:g} ms (*, moved >= {spec.convergence_tol_cm:g} cm over the last "
+          f"window): {bad}")
+
+
+def fig7_spread(model) -> None:
+    rows = [r for r in P.fig7(model) if "spread" in r.name]
+    worst = max(rows, key=lambda r: r.ours)
+    print(f"  worst spread {worst.ours:.3f} cm ({worst.name.split(':')[0]}; goal 0.05 cm)")
+
+
+def stress_volume(model) -> None:
+    rows = {r.name: r.ours for r in P.stress(model)}
+    vol = next(v for k, v in rows.items() if "volume" in k)
+    print(f"  7 N run: volume change {vol:.3f} % (goal 0.3 %), finite {bool(rows.get('finite positions', 0))}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("config", nargs="?", default=None)
@@ -155,7 +184,11 @@ def main() -> None:
                            ("jaw", "jaw EPs", lambda: jaw_eps(rest, audit, pts)),
                            ("fm", "formants", lambda: formants(cfg, model, rest, audit)),
                            ("settle", "settling after epmap.duration_ms (cm moved over the last window)",
-                            lambda: settling(cfg, model, rest))):
+                            lambda: settling(cfg, model, rest)),
+                           ("hold300", "map levels, jaw held, fixed hold (cm moved over the last window)",
+                            lambda: fixed_hold(cfg, model, rest)),
+                           ("fig7", "Fig. 7 (one EP per force)", lambda: fig7_spread(model)),
+                           ("stress", "7 N on GGp, SG, HG, SL, IL", lambda: stress_volume(model))):
         if key in parts:
             print(title)
             fn()
