@@ -85,13 +85,15 @@ def _landmark(cfg: Config, key: str):
 
 
 def build_body(cfg: Config, mesh: Mesh | None = None, *, digastric_through_sling: bool = False,
-               verticalis_sections: int = 4, il_midsagittal: bool = False, gg_tendon: str = "all") -> Body:
+               verticalis_sections: int = 4, il_midsagittal: bool = False, gg_tendon: str = "all",
+               floor_on_mylohyoid: bool = False) -> Body:
     """The articulator's nodes, links and muscle routes.
 
     ``digastric_through_sling``: the anterior digastric's fibre goes on from the sling to the mastoid (a fixed
     segment that adds its length to the fibre's); ``verticalis_sections``: the verticalis spans this many radial
     sections from the tip; ``il_midsagittal``: IL has a fibre in the midsagittal plane as well; ``gg_tendon``:
-    the mandible carries the tongue's GG tendon line in ``"all"`` three planes or the ``"midsagittal"`` one."""
+    the mandible carries the tongue's GG tendon line in ``"all"`` three planes or the ``"midsagittal"`` one;
+    ``floor_on_mylohyoid``: the floor nodes are also linked to their two nearest mylohyoid points."""
     mesh = mesh if mesh is not None else tongue_mesh(cfg.speaker.tongue)
     nr, nc, planes = mesh.grid
     if not 1 <= verticalis_sections <= nr - 1:
@@ -152,6 +154,10 @@ def build_body(cfg: Config, mesh: Mesh | None = None, *, digastric_through_sling
             near = hyoid[np.argsort(np.linalg.norm(np.array(b.points)[hyoid] - b.points[node], axis=1))[:2]]
             for h in near:
                 link(node, int(h), "floor")
+            if floor_on_mylohyoid:  # the floor of the mouth: the mylohyoid sling from the mandible
+                sling = np.array([*myl_front, *myl_mid, *myl_back])
+                for h in sling[np.argsort(np.linalg.norm(np.array(b.points)[sling] - b.points[node], axis=1))[:2]]:
+                    link(node, int(h), "floor")
 
     # --- skull points (fixed) ------------------------------------------------------------
     fixed = []

@@ -53,3 +53,20 @@ def test_the_mandible_carries_the_gg_tendon_in_every_plane_or_in_the_midline_onl
     assert len(held_every) == 3 * n_lines and len(held_mid) == n_lines
     assert np.allclose(mid.nodes[held_mid, 2], 0.0)  # the genial tubercle's plane
     assert np.array_equal(np.setdiff1d(every.carried, anchor), np.setdiff1d(mid.carried, anchor))  # bones alike
+
+
+def test_the_floor_hangs_from_the_mylohyoid_lines_when_asked(cfg, mesh):
+    """jaw.floor_on_mylohyoid: each floor node also linked to its two nearest mylohyoid points, which lie
+    above it (a sling in tension, not a strut), mirrored left to right."""
+    from artic_cli.geometry.anatomy import LINK_KINDS, build_body
+
+    kinds = {on: build_body(cfg, mesh, floor_on_mylohyoid=on) for on in (False, True)}
+    floor = LINK_KINDS.index("floor")
+    plain, sling = (b.links[b.link_kind == floor] for b in (kinds[False], kinds[True]))
+    assert len(sling) == 2 * len(plain)
+    body = kinds[True]
+    myl = {body.names[f"mylohyoid_{p}_{s}"] for p in ("front", "mid", "back") for s in ("l", "r")}
+    added = np.array([pair for pair in sling.tolist() if pair[1] in myl])
+    assert len(added) == len(plain)
+    assert (body.nodes[added[:, 1], 1] > body.nodes[added[:, 0], 1] + 0.5).all()  # each point above its node
+    assert np.isclose(body.nodes[added[:, 1], 2].sum(), 0.0)  # left and right alike
