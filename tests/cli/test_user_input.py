@@ -39,7 +39,7 @@ def test_a_target_name_cannot_choose_a_path_outside_the_output_folder(tmp_path, 
 
 def test_an_unphysical_simulation_is_written_marked_invalid_and_refused_downstream(tmp_path, mesh_file):
     sched = tmp_path / "big.yaml"
-    sched.write_text("duration_ms: 50\nmuscles:\n  - {muscle: GGp, force_n: 1000000, duration_ms: 50}\n")
+    sched.write_text("duration_ms: 50\nmuscles:\n  - {muscle: SL, force_n: 1000000, duration_ms: 50}\n")
     res = _run("simulate", "--schedule", sched, "--mesh", mesh_file, "--out", tmp_path / "big.h5")
     assert res.exit_code == 2 and "above the 50-N cap" in res.output and not (tmp_path / "big.h5").exists()
     d = yaml.safe_load((ROOT / "configs" / "default.yaml").read_text())
