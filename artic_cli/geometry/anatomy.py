@@ -27,7 +27,7 @@ from ..config import Config
 from ..errors import ArticError
 from .mesh import Mesh, tongue_node_index, tongue_mesh
 
-LINK_KINDS = ("mandible", "hyoid", "floor", "strap")
+LINK_KINDS = ("mandible", "hyoid", "floor", "strap", "sling")  # sling: the floor hung from the mylohyoid lines
 TONGUE_MUSCLES = ("GGa", "GGm", "GGp", "HG", "SG", "SL", "IL", "T", "V", "GH", "MH")
 JAW_MUSCLES = ("temporalis_anterior", "temporalis_posterior", "masseter", "medial_pterygoid",
                "lateral_pterygoid_upper", "lateral_pterygoid_lower", "anterior_digastric", "posterior_digastric")
@@ -157,7 +157,7 @@ def build_body(cfg: Config, mesh: Mesh | None = None, *, digastric_through_sling
             if floor_on_mylohyoid:  # the floor of the mouth: the mylohyoid sling from the mandible
                 sling = np.array([*myl_front, *myl_mid, *myl_back])
                 for h in sling[np.argsort(np.linalg.norm(np.array(b.points)[sling] - b.points[node], axis=1))[:2]]:
-                    link(node, int(h), "floor")
+                    link(node, int(h), "sling")
 
     # --- skull points (fixed) ------------------------------------------------------------
     fixed = []

@@ -330,9 +330,10 @@ def _links(body: Body, cfg: Config, tissue_scale: float) -> tuple[CylinderSet, n
     e[stiff] = units.kpa_to_cgs(bone.youngs_modulus_kpa)
     eta[stiff] = units.kpa_to_cgs(bone.viscosity_kpa_s)
     floor = kinds == LINK_KINDS.index("floor")
-    area[floor] = jaw.floor_link_area_cm2
-    e[floor] = tissue_scale * units.kpa_to_cgs(tissue.youngs_modulus_kpa)
-    eta[floor] = tissue_scale * units.kpa_to_cgs(tissue.viscosity_kpa_s)
+    tissue_links = floor | (kinds == LINK_KINDS.index("sling"))  # the floor's links to the hyoid and mandible
+    area[tissue_links] = jaw.floor_link_area_cm2
+    e[tissue_links] = tissue_scale * units.kpa_to_cgs(tissue.youngs_modulus_kpa)
+    eta[tissue_links] = tissue_scale * units.kpa_to_cgs(tissue.viscosity_kpa_s)
     relax = units.ms_to_s(jaw.passive_relaxation_ms)  # dashpot = relaxation time x spring
     for mask, k_n_cm in ((kinds == LINK_KINDS.index("strap"), jaw.strap_stiffness_n_per_cm),
                          (kinds == -1, jaw.passive_stiffness_n_per_cm)):
@@ -377,7 +378,7 @@ def build_articulator(cfg: Config, mesh: Mesh, wall: WallSurface | None = None, 
     link_mass = np.concatenate([tissue.density_g_cm3 * mesh.areas * tcyl.l0, lmass])
     grav = cfg.simulation.gravity_cm_s2 if gravity is None else gravity
     free = np.setdiff1d(np.arange(len(mesh.nodes)), body.carried)  # the tongue but its GG tendon on the mandible
-    carriers = np.r_[np.ones(len(tcyl), dtype=bool), lkind == LINK_KINDS.index("floor")]
+    carriers = np.r_[np.ones(len(tcyl), dtype=bool), np.isin(lkind, [LINK_KINDS.index(k) for k in ("floor", "sling")])]
     cyl = _carrying_weight(_concat(tcyl, lcyl), body.nodes, tissue, mesh, grav, free, carriers)
     on = cfg.simulation.volume_constraint if volume_constraint is None else volume_constraint
     e0 = units.kpa_to_cgs(tissue.youngs_modulus_kpa)
