@@ -148,15 +148,19 @@ def build_body(cfg: Config, mesh: Mesh | None = None, *, digastric_through_sling
     hyoid = np.array([body_l, body_r, horn_l, horn_r])
 
     # --- tongue floor on hyoid and mandible (soft links) --------------------------------
+    sling = np.array([*myl_front, *myl_mid, *myl_back])  # the floor of the mouth: the mylohyoid lines
+    points = np.array(b.points)
+
+    def nearest_two(targets, node):
+        return targets[np.argsort(np.linalg.norm(points[targets] - points[node], axis=1))[:2]]
+
     for p in range(planes):
         for j in range(2, nc):
             node = t(nr - 1, j, p)
-            near = hyoid[np.argsort(np.linalg.norm(np.array(b.points)[hyoid] - b.points[node], axis=1))[:2]]
-            for h in near:
+            for h in nearest_two(hyoid, node):
                 link(node, int(h), "floor")
-            if floor_on_mylohyoid:  # the floor of the mouth: the mylohyoid sling from the mandible
-                sling = np.array([*myl_front, *myl_mid, *myl_back])
-                for h in sling[np.argsort(np.linalg.norm(np.array(b.points)[sling] - b.points[node], axis=1))[:2]]:
+            if floor_on_mylohyoid:
+                for h in nearest_two(sling, node):
                     link(node, int(h), "sling")
 
     # --- skull points (fixed) ------------------------------------------------------------

@@ -222,16 +222,14 @@ def tongue_cylinders(mesh: Mesh, tissue: TissueMaterial, n_nodes: int) -> tuple[
     return cyl, scale, bulk_ratio
 
 
-def _carrying_weight(cyl: CylinderSet, x: np.ndarray, tissue: TissueMaterial, mesh: Mesh, gravity: float,
-                     free: np.ndarray, carriers: np.ndarray) -> CylinderSet:
+def _carrying_weight(cyl: CylinderSet, x: np.ndarray, tissue: TissueMaterial, link_mass: np.ndarray,
+                     gravity: float, free: np.ndarray, carriers: np.ndarray) -> CylinderSet:
     """The cylinders as they are, or (``tissue.rest_under_gravity``) with the rest lengths of the
     ``carriers`` (the tongue's cylinders, and the floor's links in the articulator) set to carry the weight
-    of the ``free`` tongue nodes at their drawn positions ``x``."""
+    of the ``free`` tongue nodes (the consistent mass's row sums) at their drawn positions ``x``."""
     if not tissue.rest_under_gravity or gravity == 0.0:
         return cyl
-    nt = len(mesh.cylinders)
-    m = tissue.density_g_cm3 * mesh.areas * cyl.l0[:nt]
-    node_mass = np.bincount(cyl.i[:nt], m / 2, cyl.n_nodes) + np.bincount(cyl.j[:nt], m / 2, cyl.n_nodes)
+    node_mass = np.asarray(_consistent_mass(cyl.i, cyl.j, link_mass, cyl.n_nodes).sum(axis=1)).ravel()
     return weight_carrying(cyl, x, node_mass, np.array([0.0, -gravity, 0.0]), free, carriers)
 
 
@@ -301,7 +299,7 @@ def build_model(mesh: Mesh, tissue: TissueMaterial, sim: Simulation, *,
             fixed_dofs[mesh.node_sets["midsagittal"], 2] = True
     link_mass = tissue.density_g_cm3 * mesh.areas * cyl.l0  # the paper's volumes carry the mass
     g = sim.gravity_cm_s2 if gravity is None else gravity
-    cyl = _carrying_weight(cyl, mesh.nodes, tissue, mesh, g, np.where(~fixed_dofs.all(axis=1))[0],
+    cyl = _carrying_weight(cyl, mesh.nodes, tissue, link_mass, g, np.where(~fixed_dofs.all(axis=1))[0],
                            np.ones(len(cyl), dtype=bool))
     return _finish(mesh, mesh.nodes.copy(), cyl, link_mass, kappa, fixed_dofs, sim, g, n,
                    bulk_ratio * scale * e0, node_sets=dict(mesh.node_sets))
@@ -379,7 +377,7 @@ def build_articulator(cfg: Config, mesh: Mesh, wall: WallSurface | None = None, 
     grav = cfg.simulation.gravity_cm_s2 if gravity is None else gravity
     free = np.setdiff1d(np.arange(len(mesh.nodes)), body.carried)  # the tongue but its GG tendon on the mandible
     carriers = np.r_[np.ones(len(tcyl), dtype=bool), np.isin(lkind, [LINK_KINDS.index(k) for k in ("floor", "sling")])]
-    cyl = _carrying_weight(_concat(tcyl, lcyl), body.nodes, tissue, mesh, grav, free, carriers)
+    cyl = _carrying_weight(_concat(tcyl, lcyl), body.nodes, tissue, link_mass, grav, free, carriers)
     on = cfg.simulation.volume_constraint if volume_constraint is None else volume_constraint
     e0 = units.kpa_to_cgs(tissue.youngs_modulus_kpa)
     kappa = np.full(len(mesh.bricks), bulk_ratio * scale * e0 if on else 0.0)
