@@ -106,6 +106,19 @@ class Simulation(Strict):
     midsagittal_symmetry: bool = False
 
 
+class StyloglossusFibre(Strict):
+    entry: tuple[Annotated[int, Field(ge=0)], Annotated[int, Field(ge=0)]]  # (radial, level) where it enters the tongue
+    level: Annotated[int, Field(ge=0)]  # the concentric level it runs along
+    radials: tuple[Annotated[int, Field(ge=0)], Annotated[int, Field(ge=0)]]  # from, to (toward the tip)
+
+    @field_validator("radials")
+    @classmethod
+    def _toward_tip(cls, v):
+        if v[1] > v[0]:
+            raise ValueError(f"radials {list(v)} run backward; give [from, to] with from >= to (radial 0 is the tip)")
+        return v
+
+
 class Muscles(Strict):
     thickness_cm2: dict[str, Positive] = {
         "GGa": 1.0, "GGm": 1.5, "GGp": 2.0, "HG": 1.5, "SG": 1.5, "SL": 1.0, "IL": 1.0, "T": 1.0, "V": 1.0,
@@ -120,6 +133,10 @@ class Muscles(Strict):
     # routing (docs/modelling.md): the verticalis over this many radial sections from the tip; IL also midsagittally
     verticalis_sections: Annotated[int, Field(ge=1)] = 4
     il_midsagittal: bool = False
+    # SG's fibres in each parasagittal plane: from the styloid into the tongue at node (radial, level), then
+    # forward along `level` from radial radials[0] to radials[1] (radial 0: the tip; level 0: the GG tendon)
+    styloglossus: Annotated[list[StyloglossusFibre], Field(min_length=1)] = [
+        StyloglossusFibre(entry=(8, 4), level=3, radials=(7, 1)), StyloglossusFibre(entry=(7, 5), level=5, radials=(6, 3))]
     groups: dict[str, dict[str, Positive]] = {
         "JO": {"lateral_pterygoid_upper": 0.25, "lateral_pterygoid_lower": 0.25, "anterior_digastric": 0.5},
         "JC": {"temporalis_anterior": 0.3, "temporalis_posterior": 0.2, "masseter": 0.3, "medial_pterygoid": 0.2},

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..config import Config
+from ..config import Config, Muscles
 from ..errors import ArticError
 from .mesh import Mesh, tongue_node_index, tongue_mesh
 
@@ -86,16 +86,24 @@ def _landmark(cfg: Config, key: str):
 
 def build_body(cfg: Config, mesh: Mesh | None = None, *, digastric_through_sling: bool = False,
                verticalis_sections: int = 4, il_midsagittal: bool = False, gg_tendon: str = "all",
-               floor_on_mylohyoid: bool = False) -> Body:
+               floor_on_mylohyoid: bool = False, sg_routes=None) -> Body:
     """The articulator's nodes, links and muscle routes.
 
     ``digastric_through_sling``: the anterior digastric's fibre goes on from the sling to the mastoid (a fixed
     segment that adds its length to the fibre's); ``verticalis_sections``: the verticalis spans this many radial
     sections from the tip; ``il_midsagittal``: IL has a fibre in the midsagittal plane as well; ``gg_tendon``:
     the mandible carries the tongue's GG tendon line in ``"all"`` three planes or the ``"midsagittal"`` one;
-    ``floor_on_mylohyoid``: the floor nodes are also linked to their two nearest mylohyoid points."""
+    ``floor_on_mylohyoid``: the floor nodes are also linked to their two nearest mylohyoid points;
+    ``sg_routes``: SG's fibres per side (``muscles.styloglossus`` items; None: that key's default)."""
     mesh = mesh if mesh is not None else tongue_mesh(cfg.speaker.tongue)
     nr, nc, planes = mesh.grid
+    sg_routes = Muscles().styloglossus if sg_routes is None else sg_routes
+    for i, route in enumerate(sg_routes):
+        for name, (k, j) in (("entry", route.entry), ("radials", (route.radials[0], route.level)),
+                             ("radials", (route.radials[1], route.level))):
+            if k > nr - 1 or j > nc - 1:
+                raise ArticError(f"config: muscles.styloglossus[{i}].{name} leaves the tongue (radial {k}, level {j}); "
+                                 f"radials run 0-{nr - 1} and levels 0-{nc - 1}")
     if not 1 <= verticalis_sections <= nr - 1:
         raise ArticError(f"config: muscles.verticalis_sections is {verticalis_sections}; give 1 to {nr - 1} "
                          "(the tongue's radial sections)")
@@ -202,8 +210,9 @@ def build_body(cfg: Config, mesh: Mesh | None = None, *, digastric_through_sling
         for h in ((body_l, body_r)[s], (horn_l, horn_r)[s]):
             for j in (3, 5):
                 fib["HG"].append(chain([h] + [t(k, j, p) for k in range(last, 6, -1)]))
-        fib["SG"].append(chain([styloid[s], t(8, 4, p)] + [t(k, 3, p) for k in range(7, 0, -1)]))
-        fib["SG"].append(chain([styloid[s], t(7, 5, p)] + [t(k, 5, p) for k in range(6, 2, -1)]))
+        for route in sg_routes:
+            (ke, je), (k0, k1) = route.entry, route.radials
+            fib["SG"].append(chain([styloid[s], t(ke, je, p)] + [t(k, route.level, p) for k in range(k0, k1 - 1, -1)]))
     # lower side, root to tip, in the parasagittal planes (between GG and HG) and optionally the midsagittal one
     for p in (*sides, mid) if il_midsagittal else sides:
         fib["IL"].append(chain([t(k, 2, p) for k in range(last, 0, -1)] + [t(0, j, p) for j in range(3, nc)]))

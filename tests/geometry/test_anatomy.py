@@ -70,3 +70,27 @@ def test_the_floor_hangs_from_the_mylohyoid_lines_when_asked(cfg, mesh):
     assert len(added) == len(plain) and set(added[:, 1].tolist()) <= myl
     assert (body.nodes[added[:, 1], 1] > body.nodes[added[:, 0], 1] + 0.5).all()  # each point above its node
     assert np.isclose(body.nodes[added[:, 1], 2].sum(), 0.0)  # left and right alike
+
+
+def test_styloglossus_follows_its_configured_routes(cfg, mesh):
+    """muscles.styloglossus: each fibre runs styloid -> entry node -> forward along its level, per side; a
+    route that leaves the tongue or runs backward is named."""
+    from artic_cli.config import Muscles, StyloglossusFibre
+    from artic_cli.geometry.mesh import tongue_node_index
+
+    nr, nc, _ = mesh.grid
+    routes = cfg.muscles.styloglossus
+    body = build_body(cfg, mesh, sg_routes=routes)
+    paper = build_body(cfg, mesh)  # the schema's routes
+    assert len(body.fibres["SG"]) == 2 * len(routes) and len(paper.fibres["SG"]) == 2 * len(Muscles().styloglossus)
+    styloid = {body.names["styloid_l"], body.names["styloid_r"]}
+    for fibre, route in zip(body.fibres["SG"][:len(routes)], routes):  # the left side's fibres come first
+        assert int(fibre[0]) in styloid
+        k, j, p = (np.asarray(a) for a in np.unravel_index(fibre[1:], (nr, nc, 3)))
+        assert (k[0], j[0]) == tuple(route.entry) and (j[1:] == route.level).all()
+        assert list(k[1:]) == list(range(route.radials[0], route.radials[1] - 1, -1)) and len(set(p)) == 1
+        assert np.array_equal(fibre[1:], tongue_node_index(k, j, p, nc - 1))
+    with pytest.raises(ArticError, match=r"muscles.styloglossus\[0\].entry leaves the tongue"):
+        build_body(cfg, mesh, sg_routes=[StyloglossusFibre(entry=(nr, 2), level=2, radials=(3, 1))])
+    with pytest.raises(ValueError, match="run backward"):
+        StyloglossusFibre(entry=(7, 5), level=2, radials=(1, 6))
