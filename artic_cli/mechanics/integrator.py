@@ -223,6 +223,7 @@ def _predict(state: State, h: float) -> np.ndarray:
     return state.x + h * state.v
 
 
+_REUSE_AFTER = 2  # Newton iterations of the last step up to which its matrix is reused
 _MAX_HALVINGS = 4  # a step whose Newton stalls is retried as two half steps, down to dt / 16
 
 
@@ -269,7 +270,10 @@ def _step_once(model: Model, state: State, control: Control, h: float) -> State:
     ms = model.muscles
     act = total_muscle_force(model, control.muscle_force)
     key = (c_a, c_v)
-    base = state.factor.base if state.factor is not None and state.factor.key == key else None
+    # the last step's matrix serves again only if that step converged within two iterations: in motion a
+    # matrix 5 ms old contracts at theta ~ 1 and costs an iteration before the refactor anyway
+    reuse = state.factor is not None and state.factor.key == key and state.iterations <= _REUSE_AFTER
+    base = state.factor.base if reuse else None
     factor = state.factor if base is not None else None  # rank-one part too, while the contact set holds
     prev = None
     fresh = False
