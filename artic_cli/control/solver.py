@@ -336,5 +336,6 @@ def solve_on(jm: JawMaps, target: TargetSpec, reach: float | None = None) -> lis
             f"{target.crucial.at_cm[1]:.3f}) cm is not reachable at this jaw position; the nearest reachable point "
             f"is ({point[0]:.3f}, {point[1]:.3f}) cm ({where}), {dist:.3f} cm away")
         err.nearest_cm = float(dist)  # how far the nearest reachable point is (a caller may settle for it)
+        err.nearest_point_cm = [float(point[0]), float(point[1])]
         raise err
     return cands

@@ -142,12 +142,16 @@ def solve_target(target: Path | str | TargetSpec, ctx: Context, out: Path | str 
             err = UnreachableTarget(doc["unreachable"])
             if "nearest_distance_cm" in doc:
                 err.nearest_cm = float(doc["nearest_distance_cm"])
+            if "nearest_point_cm" in doc:
+                err.nearest_point_cm = [float(c) for c in doc["nearest_point_cm"]]
             raise err
         return doc, path, True
     try:
         doc = solve(ctx, t, sim, verify, refine, budget)
     except UnreachableTarget as err:  # the answer is written too (make and scripts can report it)
         near = {"nearest_distance_cm": err.nearest_cm} if getattr(err, "nearest_cm", None) is not None else {}
+        if getattr(err, "nearest_point_cm", None) is not None:
+            near["nearest_point_cm"] = err.nearest_point_cm
         write(path, {"target": t.name, "unreachable": str(err), **near, **getattr(err, "answer", {})}, prov)
         raise
     write(path, doc, prov)

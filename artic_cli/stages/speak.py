@@ -111,11 +111,14 @@ def solution_forces(doc: dict) -> tuple[dict[str, float], bool, str]:
 
 
 def _nearer(t: TargetSpec, err: UnreachableTarget) -> TargetSpec | None:
-    """A spatial target whose tolerance reaches the nearest reachable point (to speak the nearest answer)."""
-    dist = getattr(err, "nearest_cm", None)
-    if t.crucial is None or dist is None:
+    """The spatial target moved to the nearest reachable point, its tolerance kept (to speak the nearest answer).
+
+    A tolerance widened to reach that point instead is not enough: the point lies on a net's edge, which the
+    search for candidates inside the nets' cells can miss."""
+    point = getattr(err, "nearest_point_cm", None)
+    if t.crucial is None or point is None:
         return None
-    crucial = t.crucial.model_copy(update={"tolerance_cm": float(dist) * 1.05 + 0.01})
+    crucial = t.crucial.model_copy(update={"at_cm": [float(c) for c in point]})
     return t.model_copy(update={"crucial": crucial, "name": f"{t.name}-nearest"})
 
 

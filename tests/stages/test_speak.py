@@ -198,6 +198,11 @@ def test_an_unreachable_target_exits_3_naming_its_segment_and_writes_nothing(tmp
     assert Image.open(tmp_path / "u.gif").n_frames == 29  # every 5-ms frame of 140 ms, and the start
     rec = speak.read(tmp_path / "out" / "u.h5")
     assert rec.how == ["forces given", "unreachable: nearest answer", "unreachable: nearest answer"]
+    # the nearest answer aims at the nearest reachable point the unreachable answer names, with the tolerance kept
+    answer = yaml.safe_load(next((tmp_path / "sol").glob("far-[0-9a-f]*.yaml")).read_text())
+    nearest = yaml.safe_load(next((tmp_path / "sol").glob("far-nearest-*.yaml")).read_text())
+    assert nearest["crucial"]["at_cm"] == pytest.approx(answer["nearest_point_cm"])
+    assert nearest["crucial"]["tolerance_cm"] == 0.05 and nearest["chosen"]["crucial_error_cm"] <= 0.05
 
 
 def test_praat_finds_our_formant_tracks_in_the_spoken_sound(spoken):
