@@ -202,6 +202,35 @@ def test_sg_reaches_the_palate_by_2_n(art, cfg):
     assert k_closure(art, forces=(2.0,), hold=cfg.epmap.hold_jaw)[0].ours == 2.0
 
 
+def _touching(art, rest, forces, part):
+    """{node: position} of the contact nodes of a held-jaw run (held as the maps hold the jaw) whose nearest
+    wall triangle belongs to ``part``."""
+    from artic_cli.experiments.paper import Audit
+    from artic_cli.geometry.wall import PARTS
+    from artic_cli.mechanics.contact import closest_on_triangles
+
+    traj, end = Audit(art).run(rest, forces, 0.3, True)
+    cor, out = art.contact.corners, {}
+    for c in sorted({int(c) for cs in traj.contact_nodes for c in cs}):
+        q = closest_on_triangles(np.repeat(end.x[c][None], len(cor), 0), cor[:, 0], cor[:, 1], cor[:, 2])
+        if PARTS[art.contact.wall.part[int(np.argmin(np.linalg.norm(q - end.x[c], axis=1)))]] == part:
+            out[c] = end.x[c]
+    return out
+
+
+def test_gga_puts_the_tip_on_the_lower_incisors_lingual_side(art, rest):
+    on = _touching(art, rest, {"GGa": 2.0}, "mandible")
+    assert art.control_points()["tip"] in on
+    assert all(-1.0 < p[0] < 0.0 and p[1] < -0.5 for p in on.values())  # behind the incisors, below their edge
+
+
+def test_the_blade_sides_reach_the_front_palate_at_4_n_or_less(art, rest):
+    """GGp 4 N + SL 2 N + T 2 N: the blade's lateral nodes on the palate 1.1 cm behind the incisor edge (the
+    lateral alveolar ridge), the seal /t/ and /s/ need; the midline tip stays below it."""
+    on = _touching(art, rest, {"GGp": 4.0, "SL": 2.0, "T": 2.0}, "palate")
+    assert on and all(p[0] > -1.6 and abs(p[2]) > 0.5 for p in on.values())
+
+
 def _ours(obj) -> bool:
     """Whether a collected object comes from artic's code: one of its frames, functions or tracebacks, or an
     instance of one of its classes (a cycle our steps made holds at least one of these)."""
