@@ -118,6 +118,10 @@ def read(path: Path | str) -> dict:
     return read_doc(path, "solution", STAGE.hint)
 
 
+# what an unreachable spatial answer records of the nearest reachable point: the error's attribute -> the key
+_NEAREST = {"nearest_cm": "nearest_distance_cm", "nearest_point_cm": "nearest_point_cm"}
+
+
 def solve_target(target: Path | str | TargetSpec, ctx: Context, out: Path | str | None = None,
                  sim: Simulator | None = None, verify: bool = False, refine: bool = False, budget: int = 8,
                  config: Path | str | None = None, mesh_sha256: str = "") -> tuple[dict, Path, bool]:
@@ -140,18 +144,15 @@ def solve_target(target: Path | str | TargetSpec, ctx: Context, out: Path | str 
         doc = read(path)
         if "unreachable" in doc:
             err = UnreachableTarget(doc["unreachable"])
-            if "nearest_distance_cm" in doc:
-                err.nearest_cm = float(doc["nearest_distance_cm"])
-            if "nearest_point_cm" in doc:
-                err.nearest_point_cm = [float(c) for c in doc["nearest_point_cm"]]
+            for attr, key in _NEAREST.items():
+                if key in doc:
+                    setattr(err, attr, doc[key])
             raise err
         return doc, path, True
     try:
         doc = solve(ctx, t, sim, verify, refine, budget)
     except UnreachableTarget as err:  # the answer is written too (make and scripts can report it)
-        near = {"nearest_distance_cm": err.nearest_cm} if getattr(err, "nearest_cm", None) is not None else {}
-        if getattr(err, "nearest_point_cm", None) is not None:
-            near["nearest_point_cm"] = err.nearest_point_cm
+        near = {key: getattr(err, attr) for attr, key in _NEAREST.items() if getattr(err, attr, None) is not None}
         write(path, {"target": t.name, "unreachable": str(err), **near, **getattr(err, "answer", {})}, prov)
         raise
     write(path, doc, prov)
