@@ -376,8 +376,9 @@ class VocalTract(Strict):
     """The speaker's vocal tract beyond the tongue mesh and the contact wall (midsagittal, cm; the speaker
     frame): what the area function needs (the paper's section II.A: tongue, lips, teeth, hard palate,
     velum, pharyngeal wall, larynx).  The velum is the part of the wall's midsagittal palate behind
-    ``hard_palate_end_x_cm``; the lower incisor and the lower lip move with the mandible; the larynx is
-    fixed in the head frame (the model has no thyroid or cricoid to carry it)."""
+    ``hard_palate_end_x_cm``; the lower incisor and the lower lip move with the mandible; the larynx front
+    follows the tongue root's lowest node (the vallecula) forward, by ``larynx_follows_root`` of its forward
+    move at the epiglottis tip, tapering to nothing at the glottis (0: fixed in the head frame)."""
 
     hard_palate_end_x_cm: Finite = -5.2
     velum_nasal_surface_cm: Outline  # the velum's posterior surface, hard palate end to the uvula (drawn)
@@ -385,6 +386,7 @@ class VocalTract(Strict):
     velum_port_line_cm: Annotated[list[Point2], Field(min_length=2, max_length=2)]  # the oral tract's top behind the velum
     pharynx_lower_cm: Outline  # the posterior wall below the contact wall's pharynx, down to the glottis
     larynx_front_cm: Outline  # glottis front, the laryngeal vestibule, the epiglottis to its tip
+    larynx_follows_root: Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)] = 0.0  # see the docstring
     upper_incisor_cm: Outline  # labial surface down to the incisor edge
     lower_incisor_cm: Outline  # edge down the labial surface (with the mandible)
     upper_lip_cm: Outline

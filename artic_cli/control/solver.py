@@ -82,9 +82,10 @@ class Lips(Strict):
 
 
 # lip tubes by name (VocalTractLab's JD3 vowels, the sections its lips make: /o/ 1.53 cm, 0.40-0.82 cm^2;
-# /u/ 1.91 cm, 0.33-0.41 cm^2; /a/ /e/ /i/ 0.53-0.55 cm, 1.2-2.8 cm^2); "neutral" is the config's default
+# /u/ 1.91 cm, 0.33-0.41 cm^2; /e/ /i/ 0.53-0.55 cm, 1.2-2.5 cm^2; /a/ 0.54 cm, 2.7-2.84 cm^2); "neutral" is
+# the config's default
 LIP_SHAPES = {"rounded": Lips(area_cm2=0.6, length_cm=1.5), "compressed": Lips(area_cm2=0.37, length_cm=1.9),
-              "spread": Lips(area_cm2=2.5, length_cm=0.55)}
+              "spread": Lips(area_cm2=2.5, length_cm=0.55), "open": Lips(area_cm2=2.8, length_cm=0.55)}
 
 
 class TargetSpec(Strict):
@@ -93,7 +94,7 @@ class TargetSpec(Strict):
     crucial: Crucial | None = None  # a place for a control point, or ...
     acoustic: AcousticGoal | None = None  # ... formants (a vowel): one of the two
     indecisive: list[Indecisive] = []
-    lips: Lips | Literal["neutral", "rounded", "compressed", "spread"] | None = None  # acoustic targets only
+    lips: Lips | Literal["neutral", "rounded", "compressed", "spread", "open"] | None = None  # acoustic targets only
     velum_port_cm2: Annotated[float, Field(ge=0, le=5, allow_inf_nan=False)] | None = None
     force_weight: NonNegative = 1.0  # per N^2
     distance_weight: NonNegative = 100.0  # per cm^2

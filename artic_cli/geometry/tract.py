@@ -2,8 +2,10 @@
 
 The outer contour is fixed in the head frame: the lower posterior pharyngeal wall, the contact wall's
 midsagittal pharynx and palate (velum included), the upper incisor.  The inner contour moves: the larynx
-front and the epiglottis (fixed), the tongue's midsagittal surface from the root to the tip, a bridge from
-the tip to the lower incisor edge, and the lower incisor, which with the lower lip moves with the mandible.
+front and the epiglottis (pulled forward by the tongue root's lowest node, the vallecula, as the
+hyoepiglottic ligament pulls them, a share ``larynx_follows_root`` at the epiglottis tip tapering to none at
+the glottis), the tongue's midsagittal surface from the root to the tip, a bridge from the tip to the lower
+incisor edge, and the lower incisor, which with the lower lip moves with the mandible.
 
 The grid is fixed too: lines normal to a smoothed reference midline (the spine, glottis to incisors) in the
 manner of Maeda's grid, so every frame of a simulation has the same sections, and the distances along
@@ -75,20 +77,37 @@ def apply_rigid(points: np.ndarray, rotation: np.ndarray, translation: np.ndarra
     return (p @ rotation.T + translation)[:, :2]
 
 
-def moving_parts(vt: VocalTract, tongue_cm: np.ndarray, rotation: np.ndarray, translation: np.ndarray
-                 ) -> dict[str, np.ndarray]:
+def larynx_front(vt: VocalTract, root_shift_cm: np.ndarray | None, frames: int) -> np.ndarray:
+    """The larynx front of F frames (F, n, 2): its drawn outline (glottis first) moved forward by the tongue
+    root's forward displacement from rest (the x of (F, 2)) times a share rising linearly with height from 0
+    at the glottis to ``larynx_follows_root`` at the epiglottis tip.  The hyoepiglottic ligament pulls the
+    epiglottis after the root; it cannot push it back, so a root moving back leaves the larynx in place."""
+    base = np.asarray(vt.larynx_front_cm, float)
+    out = np.broadcast_to(base, (frames, len(base), 2))
+    if root_shift_cm is None or vt.larynx_follows_root == 0.0:
+        return out
+    y = base[:, 1]
+    share = vt.larynx_follows_root * np.clip((y - y[0]) / max(y[-1] - y[0], 1e-9), 0.0, 1.0)
+    forward = np.maximum(np.asarray(root_shift_cm, float)[:, 0], 0.0)
+    return out + share[None, :, None] * np.stack([forward, np.zeros_like(forward)], axis=1)[:, None, :]
+
+
+def moving_parts(vt: VocalTract, tongue_cm: np.ndarray, rotation: np.ndarray, translation: np.ndarray,
+                 root_shift_cm: np.ndarray | None = None) -> dict[str, np.ndarray]:
     """The moving parts of F frames, (F, n, 2) each: the tongue surface (root to tip, from a tip-first
-    (F, n, 2) surface), the lower incisor and the lower lip (the mandible's R (F, 3, 3), t (F, 3))."""
-    return {"tongue": np.asarray(tongue_cm, float)[:, ::-1],
+    (F, n, 2) surface), the lower incisor and the lower lip (the mandible's R (F, 3, 3), t (F, 3)), the
+    larynx front (the root's displacement from rest (F, 2); None: at rest)."""
+    tongue = np.asarray(tongue_cm, float)[:, ::-1]
+    return {"tongue": tongue,
             "lower_incisor": apply_rigid(np.asarray(vt.lower_incisor_cm, float), rotation, translation),
-            "lower_lip": apply_rigid(np.asarray(vt.lower_lip_cm, float), rotation, translation)}
+            "lower_lip": apply_rigid(np.asarray(vt.lower_lip_cm, float), rotation, translation),
+            "larynx_front": larynx_front(vt, root_shift_cm, len(tongue))}
 
 
 def inner_polylines(vt: VocalTract, moving: dict[str, np.ndarray]) -> list[np.ndarray]:
     """The inner contour of F frames as polylines (F, n, 2): larynx front, tongue (root to tip), the bridge
     from the tip to the lower incisor edge, the lower incisor."""
-    tongue, incisor = moving["tongue"], moving["lower_incisor"]
-    larynx = np.broadcast_to(np.asarray(vt.larynx_front_cm, float), (len(tongue), len(vt.larynx_front_cm), 2))
+    tongue, incisor, larynx = moving["tongue"], moving["lower_incisor"], moving["larynx_front"]
     bridge = np.stack([tongue[:, -1], incisor[:, 0]], axis=1)
     return [larynx, tongue, bridge, incisor]
 

@@ -53,6 +53,7 @@ class Shapes:
     jaw_translation: np.ndarray  # (F, 3)
     tongue_lateral_cm: np.ndarray | None = None  # (F, n, 2) the surface in the parasagittal plane at +lateral_z_cm
     lateral_z_cm: float = 0.0
+    root_shift_cm: np.ndarray | None = None  # (F, 2) the root's lowest surface node (the vallecula) from its rest
 
 
 def surface_nodes(mesh) -> tuple[np.ndarray, np.ndarray]:
@@ -64,17 +65,20 @@ def surface_nodes(mesh) -> tuple[np.ndarray, np.ndarray]:
 def shapes_of(positions: np.ndarray, time_s: np.ndarray, mesh, rest: np.ndarray | None,
               mandible: np.ndarray | None) -> Shapes:
     """Shapes from node positions (F, N, 3): the surface nodes (tip first) in the midsagittal and the left
-    plane, and the mandible's nodes against their rest (no mandible: the jaw stays at rest)."""
+    plane, the root's lowest node and the mandible's nodes against their rest (no rest: the mesh's nodes;
+    no mandible: the jaw stays at rest)."""
     mid, lateral = surface_nodes(mesh)
     f = len(positions)
     rot = np.broadcast_to(np.eye(3), (f, 3, 3)).copy()
     tr = np.zeros((f, 3))
+    ref = np.asarray(mesh.nodes if rest is None else rest, float)
     if mandible is not None and len(mandible) >= 3 and rest is not None:
         for k in range(f):
             rot[k], tr[k] = rigid_motion(rest[mandible], positions[k, mandible])
     return Shapes(time_s=np.asarray(time_s, float), tongue_cm=positions[:, mid, :2].copy(), jaw_rotation=rot,
                   jaw_translation=tr, tongue_lateral_cm=positions[:, lateral, :2].copy(),
-                  lateral_z_cm=float(np.mean(mesh.nodes[lateral, 2])))
+                  lateral_z_cm=float(np.mean(mesh.nodes[lateral, 2])),
+                  root_shift_cm=positions[:, mid[-1], :2] - ref[mid[-1], :2])
 
 
 @dataclass
@@ -113,8 +117,7 @@ def fixed_geometry(vt: VocalTract, cfg_wall, planes_z: tuple[float, ...] = (0.0,
     key = (id(vt), id(cfg_wall), tuple(planes_z))
     if key not in _FIXED:
         fixed = outer_contour(vt, cfg_wall)
-        drawn = dict(fixed, larynx_front=np.asarray(vt.larynx_front_cm, float),
-                     upper_lip=np.asarray(vt.upper_lip_cm, float),
+        drawn = dict(fixed, upper_lip=np.asarray(vt.upper_lip_cm, float),
                      velum_nasal=np.asarray(vt.velum_nasal_surface_cm, float))
         outer = {float(z): segments(list(outer_at(vt, cfg_wall, float(z)))) for z in planes_z}
         if len(_FIXED) > 8:
@@ -133,7 +136,7 @@ def compute(vt: VocalTract, cfg_wall, shapes: Shapes, controls: dict[str, np.nda
     """The tracts of every frame; a line that misses the tract's contours is an error naming the frame."""
     geo = fixed_geometry(vt, cfg_wall, band_planes(shapes))
     grid = geo.grid
-    moving = moving_parts(vt, shapes.tongue_cm, shapes.jaw_rotation, shapes.jaw_translation)
+    moving = moving_parts(vt, shapes.tongue_cm, shapes.jaw_rotation, shapes.jaw_translation, shapes.root_shift_cm)
     inner = segments(inner_polylines(vt, moving))
     outer = geo.outer[0.0]
     law = vt.area_law
@@ -166,7 +169,8 @@ def band_area(vt: VocalTract, geo: Fixed, shapes: Shapes, af: AreaFunctions, inn
     z = np.array(list(geo.outer))
     side = [0.5 * (shapes.tongue_cm + shapes.tongue_lateral_cm), shapes.tongue_lateral_cm]
     inners = [inner_mid] + [segments(inner_polylines(vt, moving_parts(vt, tongue, shapes.jaw_rotation,
-                                                                      shapes.jaw_translation))) for tongue in side]
+                                                                      shapes.jaw_translation, shapes.root_shift_cm)))
+                            for tongue in side]
     return band_areas(geo.grid, inners, list(geo.outer.values()), z, af.inner_s_cm, af.wall_s_cm), z
 
 

@@ -196,3 +196,19 @@ def test_the_sound_of_a_closing_tract_falls_silent(work, mesh_file, dorsum_sim):
     with pytest.raises(ArticError, match="--aspiration"):
         synthesize_tracts(tracts, work / "bad.wav", 115.0, config=CONFIG, aspiration=-1.0)
     assert not (work / "bad.wav").exists()
+
+
+def test_the_root_pulled_forward_widens_the_low_pharynx_through_the_epiglottis(work, mesh_file):
+    sim = _sim(work, mesh_file, "root", [{"nodes": "root", "force_n": [1.0, 0.0, 0.0], "onset_ms": 0,
+                                          "duration_ms": 300}])
+    follows = vts.vocal_tract(sim=sim, mesh=mesh_file, config=CONFIG, out=work / "root_vt.h5").tracts
+    fixed_cfg = work / "larynx_fixed.yaml"
+    raw = yaml.safe_load(CONFIG.read_text())
+    raw["vocal_tract"]["larynx_follows_root"] = 0.0
+    fixed_cfg.write_text(yaml.safe_dump(raw))
+    fixed = vts.vocal_tract(sim=sim, mesh=mesh_file, config=fixed_cfg, out=work / "root_fixed.h5").tracts
+    low = np.array(follows.af.region_names)[follows.grid.region] == "low pharynx"
+    n = follows.grid.n_lines
+    grown = follows.af.area_cm2[:, :n][:, low] / fixed.af.area_cm2[:, :n][:, low]
+    assert np.median(grown[-1]) >= 1.3
+    assert np.median(grown[0]) <= 1.1  # settled at rest: the root where it was drawn, within 0.1 cm
