@@ -377,8 +377,9 @@ class VocalTract(Strict):
     frame): what the area function needs (the paper's section II.A: tongue, lips, teeth, hard palate,
     velum, pharyngeal wall, larynx).  The velum is the part of the wall's midsagittal palate behind
     ``hard_palate_end_x_cm``; the lower incisor and the lower lip move with the mandible; the larynx front
-    follows the tongue root's lowest node (the vallecula) forward, by ``larynx_follows_root`` of its forward
-    move at the epiglottis tip, tapering to nothing at the glottis (0: fixed in the head frame)."""
+    follows the tongue root's lowest node (the vallecula) forward and back, by ``larynx_follows_root`` of
+    its move at the epiglottis tip, tapering to nothing at the glottis (0: fixed in the head frame), and
+    stays ``larynx_wall_gap_cm`` clear of the posterior wall."""
 
     hard_palate_end_x_cm: Finite = -5.2
     velum_nasal_surface_cm: Outline  # the velum's posterior surface, hard palate end to the uvula (drawn)
@@ -387,6 +388,7 @@ class VocalTract(Strict):
     pharynx_lower_cm: Outline  # the posterior wall below the contact wall's pharynx, down to the glottis
     larynx_front_cm: Outline  # glottis front, the laryngeal vestibule, the epiglottis to its tip
     larynx_follows_root: Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)] = 0.0  # see the docstring
+    larynx_wall_gap_cm: Annotated[float, Field(ge=0, le=2, allow_inf_nan=False)] = 0.3
     upper_incisor_cm: Outline  # labial surface down to the incisor edge
     lower_incisor_cm: Outline  # edge down the labial surface (with the mandible)
     upper_lip_cm: Outline

@@ -2,9 +2,9 @@
 
 The outer contour is fixed in the head frame: the lower posterior pharyngeal wall, the contact wall's
 midsagittal pharynx and palate (velum included), the upper incisor.  The inner contour moves: the larynx
-front and the epiglottis (pulled forward by the tongue root's lowest node, the vallecula, as the
-hyoepiglottic ligament pulls them, a share ``larynx_follows_root`` at the epiglottis tip tapering to none at
-the glottis), the tongue's midsagittal surface from the root to the tip, a bridge from the tip to the lower
+front and the epiglottis (moved forward and back with the tongue root's lowest node, the vallecula, a share
+``larynx_follows_root`` at the epiglottis tip tapering to none at the glottis, kept clear of the posterior
+wall), the tongue's midsagittal surface from the root to the tip, a bridge from the tip to the lower
 incisor edge, and the lower incisor, which with the lower lip moves with the mandible.
 
 The grid is fixed too: lines normal to a smoothed reference midline (the spine, glottis to incisors) in the
@@ -77,31 +77,41 @@ def apply_rigid(points: np.ndarray, rotation: np.ndarray, translation: np.ndarra
     return (p @ rotation.T + translation)[:, :2]
 
 
-def larynx_front(vt: VocalTract, root_shift_cm: np.ndarray | None, frames: int) -> np.ndarray:
-    """The larynx front of F frames (F, n, 2): its drawn outline (glottis first) moved forward by the tongue
-    root's forward displacement from rest (the x of (F, 2)) times a share rising linearly with height from 0
-    at the glottis to ``larynx_follows_root`` at the epiglottis tip.  The hyoepiglottic ligament pulls the
-    epiglottis after the root; it cannot push it back, so a root moving back leaves the larynx in place."""
+def larynx_front(vt: VocalTract, root_shift_cm: np.ndarray | None, frames: int,
+                 back_wall_cm: np.ndarray | None = None) -> np.ndarray:
+    """The larynx front of F frames (F, n, 2): its drawn outline (glottis first) moved along x by the tongue
+    root's displacement from rest (the x of (F, 2)) times a share rising linearly with height from 0 at the
+    glottis to ``larynx_follows_root`` at the epiglottis tip.  The root pulls the epiglottis forward (the
+    hyoepiglottic ligament) and pushes it back (it lies against the vallecula); pushed back, a point stops
+    ``larynx_wall_gap_cm`` in front of the posterior wall ``back_wall_cm`` ((m, 2), top to bottom), or where
+    it was drawn if that is nearer."""
     base = np.asarray(vt.larynx_front_cm, float)
     out = np.broadcast_to(base, (frames, len(base), 2))
     if root_shift_cm is None or vt.larynx_follows_root == 0.0:
         return out
     y = base[:, 1]
     share = vt.larynx_follows_root * np.clip((y - y[0]) / max(y[-1] - y[0], 1e-9), 0.0, 1.0)
-    forward = np.maximum(np.asarray(root_shift_cm, float)[:, 0], 0.0)
-    return out + share[None, :, None] * np.stack([forward, np.zeros_like(forward)], axis=1)[:, None, :]
+    x = base[None, :, 0] + share[None, :] * np.asarray(root_shift_cm, float)[:, None, 0]
+    if back_wall_cm is not None:
+        wall = np.asarray(back_wall_cm, float)
+        order = np.argsort(wall[:, 1])
+        limit = np.interp(y, wall[order, 1], wall[order, 0]) + vt.larynx_wall_gap_cm
+        x = np.maximum(x, np.minimum(limit, base[:, 0])[None, :])
+    return np.stack([x, np.broadcast_to(y, x.shape)], axis=2)
 
 
 def moving_parts(vt: VocalTract, tongue_cm: np.ndarray, rotation: np.ndarray, translation: np.ndarray,
-                 root_shift_cm: np.ndarray | None = None) -> dict[str, np.ndarray]:
+                 root_shift_cm: np.ndarray | None = None, back_wall_cm: np.ndarray | None = None
+                 ) -> dict[str, np.ndarray]:
     """The moving parts of F frames, (F, n, 2) each: the tongue surface (root to tip, from a tip-first
     (F, n, 2) surface), the lower incisor and the lower lip (the mandible's R (F, 3, 3), t (F, 3)), the
-    larynx front (the root's displacement from rest (F, 2); None: at rest)."""
+    larynx front (the root's displacement from rest (F, 2), None: at rest; the posterior wall it keeps
+    clear of)."""
     tongue = np.asarray(tongue_cm, float)[:, ::-1]
     return {"tongue": tongue,
             "lower_incisor": apply_rigid(np.asarray(vt.lower_incisor_cm, float), rotation, translation),
             "lower_lip": apply_rigid(np.asarray(vt.lower_lip_cm, float), rotation, translation),
-            "larynx_front": larynx_front(vt, root_shift_cm, len(tongue))}
+            "larynx_front": larynx_front(vt, root_shift_cm, len(tongue), back_wall_cm)}
 
 
 def inner_polylines(vt: VocalTract, moving: dict[str, np.ndarray]) -> list[np.ndarray]:

@@ -308,8 +308,9 @@ def tract_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row], l
         fm = read_acoustics(acoustics).formants_hz[0]
         for k, (target, name) in enumerate(((500.0, "F1"), (1947.0, "F2"))):
             err = fm[k] / target - 1
-            rows.append(Row(f"rest tract [e]: {name}", f"male Japanese /e/ {target:.0f} Hz (Jo's averages)",
-                            f"{fm[k]:.0f} Hz ({100 * err:+.0f} %)", _verdict(abs(err) <= 0.10, "within 10 %")))
+            rows.append(Row(f"rest tract [e] (default lips): {name}",
+                            f"male Japanese /e/ {target:.0f} Hz (Jo's averages)", f"{fm[k]:.0f} Hz ({100 * err:+.0f} %)",
+                            _verdict(abs(err) <= 0.15, "within 15 %, the speaker's check")))
         lines += ["![The rest tract's transfer function and formants](acoustics_rest.png)",
                   "![The rest tract voiced for 1 s (F0 115 Hz)](spectrogram_rest.png)", ""]
     amaps = data / "acoustic_maps.h5"

@@ -136,7 +136,9 @@ def compute(vt: VocalTract, cfg_wall, shapes: Shapes, controls: dict[str, np.nda
     """The tracts of every frame; a line that misses the tract's contours is an error naming the frame."""
     geo = fixed_geometry(vt, cfg_wall, band_planes(shapes))
     grid = geo.grid
-    moving = moving_parts(vt, shapes.tongue_cm, shapes.jaw_rotation, shapes.jaw_translation, shapes.root_shift_cm)
+    back = geo.drawn["pharynx"]
+    moving = moving_parts(vt, shapes.tongue_cm, shapes.jaw_rotation, shapes.jaw_translation, shapes.root_shift_cm,
+                          back)
     inner = segments(inner_polylines(vt, moving))
     outer = geo.outer[0.0]
     law = vt.area_law
@@ -169,7 +171,8 @@ def band_area(vt: VocalTract, geo: Fixed, shapes: Shapes, af: AreaFunctions, inn
     z = np.array(list(geo.outer))
     side = [0.5 * (shapes.tongue_cm + shapes.tongue_lateral_cm), shapes.tongue_lateral_cm]
     inners = [inner_mid] + [segments(inner_polylines(vt, moving_parts(vt, tongue, shapes.jaw_rotation,
-                                                                      shapes.jaw_translation, shapes.root_shift_cm)))
+                                                                      shapes.jaw_translation, shapes.root_shift_cm,
+                                                                      geo.drawn["pharynx"])))
                             for tongue in side]
     return band_areas(geo.grid, inners, list(geo.outer.values()), z, af.inner_s_cm, af.wall_s_cm), z
 
