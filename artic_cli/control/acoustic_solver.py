@@ -23,11 +23,11 @@ from .solver import (Candidate, TargetSpec, _bilinear, _polyline_nearest, _settl
 FormantNets = dict  # "single/SG" | "pair/A+B" | "group/I+A+B" -> (*grid, K) formants of the net's EPs, Hz
 
 
-def within(target: TargetSpec, formants_hz) -> bool:
-    """F1 and F2 each within the target's tolerance."""
+def within(target: TargetSpec, formants_hz, share: float = 1.0) -> bool:
+    """F1 and F2 each within the target's tolerance (times ``share``)."""
     f = np.asarray(formants_hz, dtype=float)[:2]
     goal = np.asarray(target.acoustic.formants_hz[:2])
-    return bool(np.all(np.isfinite(f)) and np.all(np.abs(f / goal - 1.0) <= target.acoustic.tolerance))
+    return bool(np.all(np.isfinite(f)) and np.all(np.abs(f / goal - 1.0) <= share * target.acoustic.tolerance))
 
 
 def errors_pct(target: TargetSpec, formants_hz) -> list[float]:

@@ -21,6 +21,9 @@ from .solver import Candidate, TargetSpec, parse_target, solve_on
 TOP = 5  # candidates listed in the output
 REFINE_REACH_CM = 0.1  # with --refine and no candidate on target, ones this close may start the correction
 REFINE_TRIES = 3  # candidates --refine may try in turn
+# a formant refinement goes on, within its budget, until F1 and F2 are within this share of their tolerance:
+# the sound measured by Praat differs from the transfer function by a few per cent (docs/modelling.md, Vowels)
+AIM = 0.5
 
 
 @dataclass
@@ -179,7 +182,7 @@ def solve_acoustic(ctx: Context, target: TargetSpec, voicer=None, verify: bool =
             break
         free = _free(cand)
         r = broyden(measure, _map_jacobian(jm, cand, free, feature), cand.forces, free, goal,
-                    lambda e, v: within(target, v["formants_hz"]), left,
+                    lambda e, v: within(target, v["formants_hz"], AIM), left,
                     first=(measure(cand.forces) if k > 0 else (hz_to_bark(np.asarray(first["formants_hz"][:2])), first)),
                     upper=top_force(jm))
         left -= r.simulations + (1 if k > 0 else 0)
