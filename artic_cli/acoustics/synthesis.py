@@ -8,8 +8,11 @@ waves scatter with r = (A_k - A_k+1) / (A_k + A_k+1); |r| <= 1 for every area, s
 glottis end reflects with ``glottal_reflection`` (nearly closed).  The lips reflect through the same
 radiation load as the frequency-domain model (a piston in a baffle, parallel R-L), as a first-order filter
 (bilinear transform of (Z - Zc) / (Z + Zc), Zc = rho c / A_lips): -1 at low frequencies, with the end
-correction that lowers the formants of a wide mouth.  Each section passes ``1 - section_loss`` of a wave
-(wall and boundary-layer losses lumped).  A closed side branch (the piriform fossae, as the transfer
+correction that lowers the formants of a wide mouth.  Yielding walls, as the transfer function has them (mass,
+resistance and stiffness per unit area; Ishizaka et al. 1975's form): at each junction a patch of wall, the
+perimeter 2 sqrt(pi A) times a section's length, moves under the junction pressure and takes its volume
+velocity from the junction's flow (the wall's velocity from the sample before, then its state stepped
+semi-implicitly).  Each section passes ``1 - section_loss`` of a wave (boundary-layer losses lumped).  A closed side branch (the piriform fossae, as the transfer
 function has them) joins at a three-tube junction: one pressure 2 sum(A p_in) / sum(A), each tube's
 outgoing wave that pressure less its incoming one.  Turbulence noise
 (frication, bursts) enters as a series pressure source at a junction, half its pressure sent each way.  The
@@ -29,7 +32,7 @@ MIN_AREA_CM2 = 1e-4
 
 @njit(cache=True)
 def _line(frame_areas, frame_index, source, glottal_reflection, rho, c, fs, loss, branch_at,
-          branch_areas, noise, noise_at):  # pragma: no cover - compiled
+          branch_areas, noise, noise_at, wall_m, wall_r, wall_k):  # pragma: no cover - compiled
     n_samples = source.shape[0]
     n = frame_areas.shape[1]
     fwd = np.zeros(n)
@@ -48,6 +51,11 @@ def _line(frame_areas, frame_index, source, glottal_reflection, rho, c, fs, loss
     last_f = 0.0
     last_b = 0.0
     pi = np.pi
+    wall_x = np.zeros(n)  # each junction's wall patch: displacement (cm) and velocity (cm/s)
+    wall_v = np.zeros(n)
+    walls = wall_m > 0.0
+    dt = 1.0 / fs
+    dx = c / fs
     for s in range(n_samples):
         pos = frame_index[s]
         k0 = int(pos)
@@ -65,6 +73,14 @@ def _line(frame_areas, frame_index, source, glottal_reflection, rho, c, fs, loss
                 new_f[j + 1] = pj - bwd[j + 1]
                 new_b[j] = pj - fwd[j]
                 new_bf[0] = pj - bb[0]
+                continue
+            if walls:  # the junction's flow less what its wall patch takes: p / (rho c) = f + b, U = A (f - b)
+                patch = 2.0 * np.sqrt(pi * 0.5 * (area[j] + area[j + 1])) * dx
+                pj = (2.0 * (area[j] * fwd[j] + area[j + 1] * bwd[j + 1]) - patch * wall_v[j]) / (area[j] + area[j + 1])
+                new_f[j + 1] = pj - bwd[j + 1]
+                new_b[j] = pj - fwd[j]
+                wall_v[j] += dt * (rho * c * pj - wall_r * wall_v[j] - wall_k * wall_x[j]) / wall_m
+                wall_x[j] += dt * wall_v[j]
                 continue
             r = (area[j] - area[j + 1]) / (area[j] + area[j + 1])
             new_f[j + 1] = (1.0 + r) * fwd[j] - r * bwd[j + 1]
@@ -140,12 +156,14 @@ def noise_samples(frame_times_s: np.ndarray, rms: np.ndarray, at_fraction: np.nd
 def synthesize(frame_areas: np.ndarray, frame_times_s: np.ndarray, source: np.ndarray, fs_internal: float,
                glottal_reflection: float = 0.97, section_loss: float = 5e-4, rho: float = 1.14e-3,
                c: float = 35000.0, branch: tuple[int, np.ndarray] | None = None, flow_peak_cm3_s: float | None = None,
-               noise: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
+               noise: tuple[np.ndarray, np.ndarray] | None = None,
+               walls: tuple[float, float, float] | None = None) -> np.ndarray:
     """The radiated sound at ``fs_internal`` for areas (frames x N equal sections) at ``frame_times_s`` and a
     source (flow derivative per internal sample); ``branch``: a closed side tube, (the section after which it
     joins, its areas), from :func:`side_branch`; ``flow_peak_cm3_s``: the glottal flow's peak (else arbitrary
     units); ``noise``: a pressure source per internal sample (dyn/cm^2) and the section after which it acts (-1:
-    none), on the same scale as a flow of ``flow_peak_cm3_s``."""
+    none), on the same scale as a flow of ``flow_peak_cm3_s``; ``walls``: (mass g/cm^2, resistance dyn s/cm^3,
+    stiffness dyn/cm^3) per unit area of yielding wall (None: rigid)."""
     t = np.arange(len(source)) / fs_internal
     index = np.interp(t, frame_times_s, np.arange(len(frame_times_s))) if len(frame_times_s) > 1 else np.zeros(len(t))
     # the source drives flow: integrate its derivative (leaky, so no drift) before it enters the line
@@ -156,4 +174,5 @@ def synthesize(frame_areas: np.ndarray, frame_times_s: np.ndarray, source: np.nd
     p_noise, k_noise = (np.zeros(len(source)), np.full(len(source), -1, np.int64)) if noise is None else noise
     return _line(np.ascontiguousarray(frame_areas, dtype=float), index.astype(float), flow,
                  glottal_reflection, rho, c, float(fs_internal), section_loss, at, areas,
-                 np.ascontiguousarray(p_noise, dtype=float), np.ascontiguousarray(k_noise, dtype=np.int64))
+                 np.ascontiguousarray(p_noise, dtype=float), np.ascontiguousarray(k_noise, dtype=np.int64),
+                 *((0.0, 0.0, 0.0) if walls is None else tuple(float(v) for v in walls)))

@@ -97,7 +97,9 @@ def compute_frames(lengths_cm: np.ndarray, areas_cm2: np.ndarray, times_s: np.nd
         rms, at_fraction, seed = noise
         pn = noise_samples(np.asarray(times_s, float), rms, at_fraction, t, n, seed)
     y = synthesize(areas, np.asarray(times_s, float) - float(times_s[0]), src, fs, sy.glottal_reflection,
-                   sy.section_loss, ac.air_density_g_cm3, ac.sound_speed_cm_s, branch, flow_peak_cm3_s, pn)
+                   sy.section_loss, ac.air_density_g_cm3, ac.sound_speed_cm_s, branch, flow_peak_cm3_s, pn,
+                   (ac.wall_mass_g_cm2, ac.wall_resistance_dyn_s_cm3, ac.wall_stiffness_dyn_cm3)
+                   if ac.yielding_walls else None)
     y = resample_poly(y, 1, 2)
     peak = float(np.max(np.abs(y))) if len(y) else 0.0
     return Audio(0.9 * y / peak if peak > 0 else y, sy.sample_rate_hz)

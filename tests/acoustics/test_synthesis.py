@@ -63,7 +63,9 @@ def test_praat_measures_our_transfer_function_formants_in_the_sound(vowel, tmp_p
     ours, _ = formants(lambda f: np.abs(transfer(tract, f, air)))
     fm = parselmouth.Sound(str(tmp_path / "v.wav")).to_formant_burg(0.01, 5, 5000, 0.025, 50)
     times = np.linspace(0.2, 0.4, 9)
-    for k, tol in ((0, 0.10), (1, 0.05)):  # Burg may insert spurious peaks: take the one nearest ours
+    # F1 within 6 %: the line's yielding walls (a rigid line put /i/'s F1 9.3 % low, /u/'s 5.6 %); Burg may
+    # insert spurious peaks: take the one nearest ours
+    for k, tol in ((0, 0.06), (1, 0.05)):
         found = [np.nanmedian([fm.get_value_at_time(j, x) for x in times]) for j in range(1, 6)]
         nearest = min(found, key=lambda v: abs(v - ours[k]))
         assert abs(nearest / ours[k] - 1) < tol, (vowel, k + 1, nearest, ours[k], found)
