@@ -11,8 +11,8 @@ radiation load as the frequency-domain model (a piston in a baffle, parallel R-L
 correction that lowers the formants of a wide mouth.  Yielding walls, as the transfer function has them (mass,
 resistance and stiffness per unit area; Ishizaka et al. 1975's form): at each junction a patch of wall, the
 perimeter 2 sqrt(pi A) times a section's length, moves under the junction pressure and takes its volume
-velocity from the junction's flow (the wall's velocity from the sample before, then its state stepped
-semi-implicitly).  Each section passes ``1 - section_loss`` of a wave (boundary-layer losses lumped).  A closed side branch (the piriform fossae, as the transfer
+velocity from the junction's flow (the wall's velocity and the junction's pressure solved together, a
+backward-Euler step).  Each section passes ``1 - section_loss`` of a wave (boundary-layer losses lumped).  A closed side branch (the piriform fossae, as the transfer
 function has them) joins at a three-tube junction: one pressure 2 sum(A p_in) / sum(A), each tube's
 outgoing wave that pressure less its incoming one.  Turbulence noise
 (frication, bursts) enters as a series pressure source at a junction, half its pressure sent each way.  The
@@ -76,11 +76,16 @@ def _line(frame_areas, frame_index, source, glottal_reflection, rho, c, fs, loss
                 continue
             if walls:  # the junction's flow less what its wall patch takes: p / (rho c) = f + b, U = A (f - b)
                 patch = 2.0 * np.sqrt(pi * 0.5 * (area[j] + area[j + 1])) * dx
-                pj = (2.0 * (area[j] * fwd[j] + area[j + 1] * bwd[j + 1]) - patch * wall_v[j]) / (area[j] + area[j + 1])
+                a_sum = area[j] + area[j + 1]
+                into = 2.0 * (area[j] * fwd[j] + area[j + 1] * bwd[j + 1])
+                # the wall's velocity and the junction's pressure solved together (backward Euler): stable for
+                # any area, a closure's slit included
+                wall_v[j] = ((wall_m / dt) * wall_v[j] + rho * c * into / a_sum - wall_k * wall_x[j]) / (
+                    wall_m / dt + rho * c * patch / a_sum + wall_r + wall_k * dt)
+                wall_x[j] += dt * wall_v[j]
+                pj = (into - patch * wall_v[j]) / a_sum
                 new_f[j + 1] = pj - bwd[j + 1]
                 new_b[j] = pj - fwd[j]
-                wall_v[j] += dt * (rho * c * pj - wall_r * wall_v[j] - wall_k * wall_x[j]) / wall_m
-                wall_x[j] += dt * wall_v[j]
                 continue
             r = (area[j] - area[j + 1]) / (area[j] + area[j + 1])
             new_f[j + 1] = (1.0 + r) * fwd[j] - r * bwd[j + 1]

@@ -33,19 +33,25 @@ def test_the_lf_source_has_zero_net_flow_and_its_peak_excitation_at_te():
     assert abs(np.argmin(d[:period]) / period - 0.56) < 0.01
 
 
-def test_a_closure_stays_stable_and_silent_behind_it():
+@pytest.mark.parametrize("walls", [None, (2.4, 5000.0, 1.0e5)], ids=["rigid", "yielding"])
+def test_a_closure_stays_stable_and_silent_behind_it(walls):
     fs = 88200
     open_ = resample_tube(np.array([17.5]), np.array([4.0]), 44)
     shut = open_.copy()
     shut[30:33] = 0.0
     src = lf_flow_derivative(np.full(fs // 5, 110.0), fs)
-    y_open = synthesize(open_[None], np.array([0.0]), src, fs)
-    y_shut = synthesize(shut[None], np.array([0.0]), src, fs)
+    y_open = synthesize(open_[None], np.array([0.0]), src, fs, walls=walls)
+    y_shut = synthesize(shut[None], np.array([0.0]), src, fs, walls=walls)
     assert np.isfinite(y_shut).all() and np.abs(y_shut).max() < 0.01 * np.abs(y_open).max()
     frames = np.array([shut, shut, open_])  # closed, then released at 0.1 s
-    y = synthesize(frames, np.array([0.0, 0.1, 0.12]), src, fs)
+    y = synthesize(frames, np.array([0.0, 0.1, 0.12]), src, fs, walls=walls)
     assert np.isfinite(y).all()
     assert np.abs(y[: int(0.09 * fs)]).max() < 0.01 * np.abs(y[int(0.15 * fs):]).max()
+    assert np.abs(y[int(0.12 * fs):]).max() < 5 * np.abs(y_open).max()  # the release: a burst, not a blow-up
+    slit = open_.copy()
+    slit[30:33] = 1e-3  # a slit: the walls beside it stay stable
+    y_slit = synthesize(slit[None], np.array([0.0]), src, fs, walls=walls)
+    assert np.isfinite(y_slit).all() and np.abs(y_slit).max() < np.abs(y_open).max()
 
 
 @pytest.mark.parametrize("vowel", sorted(VOWELS))
