@@ -424,6 +424,9 @@ class Speech(Strict):
     """How an utterance is spoken (``artic speak``): the force course, the glottis and the lungs."""
 
     ramp_ms: Annotated[float, Field(ge=0, le=500, allow_inf_nan=False)] = 30.0  # each target's forces ramp in over this
+    # each segment's muscle forces switch on this long before its sound starts (the first at t = 0): speech
+    # muscles' EMG leads the acoustic event (0: at the segment's start, as the paper's controller switches them)
+    lead_ms: Annotated[float, Field(ge=0, le=300, allow_inf_nan=False)] = 0.0
     # the muscles' force follows the course with first-order activation dynamics, rising and falling with these
     # time constants (beyond the paper, whose forces follow their commands at once: 0, 0)
     activation_rise_ms: Annotated[float, Field(ge=0, le=200, allow_inf_nan=False)] = 0.0
@@ -439,6 +442,8 @@ class Speech(Strict):
     force_course: Literal["static", "pulse_step"] = "static"
     pulse_ms: Annotated[float, Field(gt=0, le=200, allow_inf_nan=False)] = 40.0
     pulse_gain: Annotated[float, Field(ge=0, le=5, allow_inf_nan=False)] = 1.0
+    # muscle or group pairs whose pulses cross over: a pulse that would pull one side below zero drives the other
+    pulse_antagonists: list[Annotated[list[str], Field(min_length=2, max_length=2)]] = [["JO", "JC"]]
     reach_hold_ms: Annotated[float, Field(ge=0, le=2000, allow_inf_nan=False)] = 400.0  # each set held this long
     # from rest gives its EP, the place the segment heads for (0: not measured)
     frame_ms: Annotated[float, Field(gt=0, le=50, allow_inf_nan=False)] = 5.0  # tract frames (the sound's)

@@ -41,17 +41,32 @@ def course(starts_s, vectors, ramp_s: float, initial=None):
     return at
 
 
-def pulse_step(starts_s, durations_s, vectors, pulse_s: float, gain: float, upper: float):
+def to_antagonists(pulse: np.ndarray, antagonists) -> np.ndarray:
+    """A pulse (M,) whose muscles would pull negatively: each pair's (shares_a (M,), shares_b (M,)) negative
+    pull on one side becomes a positive pull of the same size on the other, spread by its shares."""
+    out = np.array(pulse, float)
+    for a, b in antagonists:
+        for this, other in ((np.asarray(a, float), np.asarray(b, float)), (np.asarray(b, float),
+                                                                          np.asarray(a, float))):
+            deficit = float(np.sum(np.maximum(-pulse, 0.0)[this > 0]))
+            if deficit > 0 and other.sum() > 0:
+                out += deficit * other / other.sum()
+    return out
+
+
+def pulse_step(starts_s, durations_s, vectors, pulse_s: float, gain: float, upper: float, antagonists=()):
     """The sets of a pulse-step course (beyond the paper): each segment opens with a pulse of
-    ``F_k + gain (F_k - F_k-1)`` (clipped to 0..``upper``) for ``pulse_s`` (at most half the segment), then
-    holds F_k; returns the starts and vectors to give :func:`course`."""
+    ``F_k + gain (F_k - F_k-1)`` for ``pulse_s`` (at most half the segment), then holds F_k; a pulse below zero
+    in one of the ``antagonists`` pairs (shares_a, shares_b) drives the other side instead (a jaw that has to
+    close closes with its closers, as it opened with its openers); clipped to 0..``upper``.  Returns the
+    starts and vectors to give :func:`course`."""
     v = np.asarray(vectors, float)
     starts, sets = [], []
     before = np.zeros(v.shape[1])
     for t0, d, f in zip(np.asarray(starts_s, float), np.asarray(durations_s, float), v):
         width = min(pulse_s, 0.5 * d)
         starts += [t0, t0 + width]
-        sets += [np.clip(f + gain * (f - before), 0.0, upper), f]
+        sets += [np.clip(to_antagonists(f + gain * (f - before), antagonists), 0.0, upper), f]
         before = f
     return np.array(starts), np.array(sets)
 

@@ -410,10 +410,11 @@ def utterance_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row
     lag = (f", the muscles following them through first-order activation dynamics ({rise:g} ms rising, {fall:g} ms "
            "falling; the paper's forces follow at once)") if rise > 0 or fall > 0 else ""
     lines = ["Each utterance is a list of targets with durations (`configs/utterances/`), spoken by `artic speak "
-             f"--accept-nearest`: every target solved once, its forces ramped in over {ramp} at its segment's start "
-             f"and held (the paper's static forces){lag}, the whole simulated with contact, then tract, formants and "
-             "sound (LF voice, off in voiceless segments; turbulence noise at the narrowest place).  Formants are "
-             "our transfer function's, medians over each segment's middle half.", ""]
+             f"--accept-nearest`: every target solved once, its forces ramped in over {ramp} and held (the paper's "
+             "static forces) or opened with a pulse (`pulse_step`, beyond the paper), switched on at the segment's "
+             f"start or a lead before it (each line names its course){lag}, the whole simulated with contact, then "
+             "tract, formants and sound (LF voice, off in voiceless segments; turbulence noise at the narrowest "
+             "place).  Formants are our transfer function's, medians over each segment's middle half.", ""]
     pictures: list[str] = []
     for path, rec in records:
         wav = path.with_suffix(".wav")
@@ -425,7 +426,8 @@ def utterance_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row
         clos = ", ".join(f"{c['duration_ms']:.0f} ms at {c['start_s']:.2f} s" for c in m["closures"]) or "none"
         sp = m["peak_speed_cm_s"]
         tg = path.with_suffix(".TextGrid")
-        lines.append(f"* /{name}/: {segs}; closures: {clos}; narrowest {m['min_constriction_cm2']:.2f} cm^2; peak "
+        lines.append(f"* /{name}/ ({rec.force_course} forces, {rec.lead_ms:g} ms ahead): {segs}; closures: {clos}; "
+                     f"narrowest {m['min_constriction_cm2']:.2f} cm^2; peak "
                      f"speeds tip / dorsum / jaw {sp.get('tip', np.nan):.1f} / {sp.get('dorsum', np.nan):.1f} / "
                      f"{sp.get('jaw', np.nan):.1f} cm/s; listen: [{wav.name}]({os.path.relpath(wav, out_dir)}), "
                      f"[{tg.name}]({os.path.relpath(tg, out_dir)})")

@@ -15,7 +15,7 @@ freshness record and is written last.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Callable
 
@@ -31,7 +31,7 @@ from ..control.targets import load_target
 from ..errors import ArticError, NotPhysical, UnreachableTarget
 from ..io.fingerprint import digest
 from ..io.store import atomic_h5, atomic_path, open_artifact, stored_content_hash
-from ..mechanics.loads import muscle_force_vector
+from ..mechanics.loads import muscle_force_vector, muscle_shares
 from ..mechanics.model import ARTICULATOR_SECTIONS, Control
 from ..mechanics.simulate import Trajectory, run, settle
 from ..schedule import TractEntry
@@ -83,6 +83,7 @@ class Spoken:
     force_course: str  # static or pulse_step
     ramp_ms: float  # each segment's ramp
     activation_ms: tuple[float, float]  # the muscles' activation rise and fall time constants (0, 0: none)
+    lead_ms: float = 0.0  # each segment's forces switch on this long before its sound
 
 
 # --- the plan: targets -> forces ---------------------------------------------------------------------
@@ -280,14 +281,19 @@ def compute(u: Utterance, p: Plan, cfg: Config, mesh, wall, progress=None, model
     vectors = np.array([muscle_force_vector(model, f) for f in p.forces_n])
     ramp_s = units.ms_to_s(sp.ramp_ms if u.ramp_ms is None else u.ramp_ms)
     how = sp.force_course if u.force_course is None else u.force_course
+    # the course runs on a clock that starts ``lead`` before the sound: every segment's forces switch on
+    # ``lead`` before its sound, the first one's during a silent lead-in that the record leaves out
+    lead = units.ms_to_s(sp.lead_ms if u.lead_ms is None else u.lead_ms)
     starts, sets = p.starts_s, vectors
     if how == "pulse_step":
+        pairs = [(muscle_shares(model, a), muscle_shares(model, b)) for a, b in sp.pulse_antagonists
+                 if a in names and b in names]
         starts, sets = pulse_step(p.starts_s, p.durations_s, vectors, units.ms_to_s(sp.pulse_ms), sp.pulse_gain,
-                                  units.newton_to_dyn(view.muscles.max_force_n))
+                                  units.newton_to_dyn(view.muscles.max_force_n), pairs)
     force_at = course(starts, sets, ramp_s)
     duration = float(p.starts_s[-1] + p.durations_s[-1])
     if sp.activation_rise_ms > 0 or sp.activation_fall_ms > 0:
-        force_at = activated(force_at, duration, units.ms_to_s(sp.activation_rise_ms),
+        force_at = activated(force_at, duration + lead, units.ms_to_s(sp.activation_rise_ms),
                              units.ms_to_s(sp.activation_fall_ms))
     zero = np.zeros((model.n_nodes, 3))
     clock = [time.perf_counter()]
@@ -298,13 +304,18 @@ def compute(u: Utterance, p: Plan, cfg: Config, mesh, wall, progress=None, model
         timings[name] = now - clock[0]
         clock[0] = now
 
-    start = settle(model)
+    rest = settle(model)
     lap("rest posture")
-    eps = equilibria(model, start, vectors, units.ms_to_s(sp.reach_hold_ms), units.ms_to_s(view.simulation.dt_ms))
-    lap("segment EPs")
     dt = units.ms_to_s(view.simulation.dt_ms)
+    eps = equilibria(model, rest, vectors, units.ms_to_s(sp.reach_hold_ms), dt)
+    lap("segment EPs")
+    start = rest
+    if lead > 0:  # the lead-in: the first segment's forces act before the sound starts
+        _, start = run(model, rest, lambda t: Control(node_force=zero, muscle_force=force_at(t)), lead, dt)
+        start = replace(start, t=0.0)
+        lap("lead-in")
     every = max(1, int(round(units.ms_to_s(sp.frame_ms) / dt)))
-    traj, _ = run(model, start, lambda t: Control(node_force=zero, muscle_force=force_at(t)), duration, dt,
+    traj, _ = run(model, start, lambda t: Control(node_force=zero, muscle_force=force_at(t + lead)), duration, dt,
                   record_every=every, progress=progress, keep_partial=True)
     lap("simulation")
     beyond = 0.0
@@ -353,13 +364,13 @@ def compute(u: Utterance, p: Plan, cfg: Config, mesh, wall, progress=None, model
                                      flow_peak_cm3_s=sp.glottal_flow_peak_cm3_s, noise=noise)
     lap("sound")
     cps = {name: traj.x[:, idx] for name, idx in model.control_points().items()}
-    commanded = np.array([force_at(float(t)) for t in traj.time])
+    commanded = np.array([force_at(float(t) + lead) for t in traj.time])
     return Spoken(utterance=u, plan=p, trajectory=traj, tracts=tracts, formants_hz=formants_hz, noise=tb,
                   glottis_cm2=glottis, audio=audio, control_points=cps, muscle_names=list(model.muscle_names),
                   muscle_force_n=units.dyn_to_newton(commanded), timings_s=timings, segment_eps_cm=eps,
                   beyond_wall_cm=beyond,
                   force_course=how, ramp_ms=units.s_to_ms(ramp_s),
-                  activation_ms=(sp.activation_rise_ms, sp.activation_fall_ms))
+                  activation_ms=(sp.activation_rise_ms, sp.activation_fall_ms), lead_ms=units.s_to_ms(lead))
 
 
 # --- files ---------------------------------------------------------------------------------------------
@@ -410,6 +421,7 @@ def write(wav: Path | str, s: Spoken, prov=None) -> dict[str, Path]:
         g.attrs["force_course"] = s.force_course
         g.attrs["ramp_ms"] = s.ramp_ms
         g.attrs["activation_ms"] = np.asarray(s.activation_ms, float)
+        g.attrs["lead_ms"] = s.lead_ms
         g.create_dataset("lip_area", data=np.array([a for a, _ in p.lips])).attrs["units"] = "cm^2"
         g.create_dataset("lip_length", data=np.array([b for _, b in p.lips])).attrs["units"] = "cm"
         names = sorted({m for f_ in p.forces_n for m in f_})
@@ -470,6 +482,7 @@ class Record:
     force_course: str
     ramp_ms: float
     activation_ms: tuple[float, float]
+    lead_ms: float = 0.0
 
 
 def read(path: Path | str) -> Record:
@@ -486,7 +499,8 @@ def read(path: Path | str) -> Record:
                           eps_cm=g["ep"][()], commanded_n=f["muscles/commanded"][()],
                           force_course=str(g.attrs.get("force_course", "static")),
                           ramp_ms=float(g.attrs.get("ramp_ms", 30.0)),
-                          activation_ms=tuple(float(v) for v in g.attrs.get("activation_ms", (0.0, 0.0))))
+                          activation_ms=tuple(float(v) for v in g.attrs.get("activation_ms", (0.0, 0.0))),
+                          lead_ms=float(g.attrs.get("lead_ms", 0.0)))
         except (KeyError, ValueError, OSError) as err:
             raise ArticError(f"{path} is damaged or incomplete ({type(err).__name__}); {STAGE.hint}") from None
 

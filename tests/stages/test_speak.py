@@ -72,7 +72,7 @@ def test_the_air_stops_at_a_closure_and_is_turbulent_in_a_narrow_channel():
                                                                        1800.0, 0.05)
 
 
-LAB = {"name": "lab", "f0_hz": [[0.0, 125], [0.75, 100]],
+LAB = {"name": "lab", "f0_hz": [[0.0, 125], [0.75, 100]], "force_course": "static", "lead_ms": 0,
        "segments": [dict(A, duration_ms=200), {"forces_n": {"JO": 0.5}, "duration_ms": 100, "label": "p",
                                                  "voiced": False},
                     dict(A), {"forces_n": {"JO": 0.5}, "duration_ms": 150, "label": "f", "voiced": False},
@@ -171,6 +171,45 @@ def test_a_pulse_step_course_opens_each_segment_with_a_clipped_pulse():
     starts, sets = pulse_step([0.0, 0.2], [0.2, 0.05], np.array([[4.0, 0.0], [1.0, 3.0]]), 0.04, 1.0, 6.0)
     assert starts.tolist() == pytest.approx([0.0, 0.04, 0.2, 0.225])  # the second pulse: half its 50-ms segment
     assert sets.tolist() == [[6.0, 0.0], [4.0, 0.0], [0.0, 6.0], [1.0, 3.0]]  # 4 + 4 capped at 6; 1 - 3 at 0
+
+
+def test_a_jaw_pulse_below_zero_drives_the_closers():
+    from artic_cli.control.course import pulse_step
+
+    jo, jc = np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.5, 0.5])  # unit shares: an opener, two closers
+    starts, sets = pulse_step([0.0, 0.2], [0.2, 0.2], np.array([[4.0, 0.0, 0.0], [0.0, 0.0, 0.0]]), 0.04, 1.5, 6.0,
+                              [(jo, jc)])
+    assert sets[0].tolist() == [6.0, 0.0, 0.0]  # 4 + 1.5 x 4, capped
+    assert sets[2].tolist() == [0.0, 3.0, 3.0]  # 0 - 1.5 x 4 = -6 N of opener: 6 N of closers, by their shares
+    assert sets[3].tolist() == [0.0, 0.0, 0.0]
+    _, plain = pulse_step([0.0, 0.2], [0.2, 0.2], np.array([[4.0, 0.0, 0.0], [0.0, 0.0, 0.0]]), 0.04, 1.5, 6.0)
+    assert plain[2].tolist() == [0.0, 0.0, 0.0]  # without the pair the pulse is clipped at zero
+
+
+def test_a_lead_switches_each_segment_s_forces_on_before_its_sound(tmp_path, mesh_file):
+    doc = {"name": "lead", "force_course": "static", "f0_hz": [[0.0, 120]],
+           "segments": [{"forces_n": {"JO": 2.5}, "duration_ms": 150, "label": "a"},
+                        {"forces_n": {"GGp": 2.0}, "duration_ms": 150, "label": "i"}]}
+    recs = {}
+    for lead in (0, 100):
+        u = _write(tmp_path / f"lead{lead}.yaml", dict(doc, lead_ms=lead))
+        res = _run("speak", u, "--mesh", mesh_file, "--out", tmp_path / f"lead{lead}.wav")
+        assert res.exit_code == 0, res.output
+        recs[lead] = speak.read(tmp_path / f"lead{lead}.h5")
+    now, ahead = recs[0], recs[100]
+    assert ahead.lead_ms == 100.0 and now.lead_ms == 0.0
+    import h5py
+
+    with h5py.File(tmp_path / "lead100.h5") as f:
+        names = [str(n) for n in f["muscles"].attrs["names"]]
+    ggp = [k for k, n in enumerate(names) if n.startswith("GGp")]
+    t, t0 = ahead.time_s, now.time_s
+    at = lambda rec, x: rec.commanded_n[np.searchsorted(rec.time_s, x)]  # noqa: E731
+    assert at(ahead, 0.14)[ggp].sum() > 1.9  # GGp's segment starts at 0.15 s, its forces at 0.05 s
+    assert at(now, 0.14)[ggp].sum() == 0.0
+    jaw = lambda rec: rec.control_points["jaw"][:, 1]  # noqa: E731
+    assert jaw(ahead)[0] < jaw(now)[0] - 0.1  # the jaw already opening when the sound starts
+    assert len(t) == len(t0) and t[0] == pytest.approx(0.0)
 
 
 def test_an_unreachable_target_exits_3_naming_its_segment_and_writes_nothing(tmp_path, mesh_file):
