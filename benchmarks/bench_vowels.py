@@ -46,7 +46,9 @@ def main() -> None:
         prov = am_stage.STAGE.provenance(cfg, inputs={"mesh": m.content_sha256,
                                                       "epmaps": str(stored_content_hash(maps))})
         am_stage.write(amaps, am_stage.compute(cfg, m.mesh, ep, jaws=["rest"]), prov)
-        target = load_target(ROOT / "configs" / "targets" / "vowels" / "e.yaml")  # neutral lips: the stored formants
+        target = load_target(ROOT / "configs" / "targets" / "vowels" / "e.yaml")
+        # at the rest jaw with neutral lips: the acoustic map's stored formants
+        target = target.model_copy(update={"jaw": target.jaw.model_copy(update={"forces_n": {}}), "lips": "neutral"})
         ctx = add_formants(load_context(maps, None, mesh), maps, mesh, None, amaps)
         times = []
         for _ in range(5):
