@@ -12,8 +12,8 @@ correction that lowers the formants of a wide mouth.  Yielding walls, as the tra
 resistance and stiffness per unit area; Ishizaka et al. 1975's form): at each junction a patch of wall, the
 perimeter 2 sqrt(pi A) times a section's length, moves under the junction pressure and takes its volume
 velocity from the junction's flow (the wall's velocity and the junction's pressure solved together, a
-backward-Euler step).  Each section passes ``1 - section_loss`` of a wave (boundary-layer losses lumped).  A closed side branch (the piriform fossae, as the transfer
-function has them) joins at a three-tube junction: one pressure 2 sum(A p_in) / sum(A), each tube's
+backward-Euler step).  Each section passes ``1 - section_loss`` of a wave (boundary-layer losses lumped).
+A closed side branch (the piriform fossae, as the transfer function has them) joins at a three-tube junction: one pressure 2 sum(A p_in) / sum(A), each tube's
 outgoing wave that pressure less its incoming one.  Turbulence noise
 (frication, bursts) enters as a series pressure source at a junction, half its pressure sent each way.  The
 radiated sound is the time derivative of the lips' volume velocity, brought to the audio rate by a polyphase

@@ -286,8 +286,12 @@ def compute(u: Utterance, p: Plan, cfg: Config, mesh, wall, progress=None, model
     lead = units.ms_to_s(sp.lead_ms if u.lead_ms is None else u.lead_ms)
     starts, sets = p.starts_s, vectors
     if how == "pulse_step":
-        pairs = [(muscle_shares(model, a), muscle_shares(model, b)) for a, b in sp.pulse_antagonists
-                 if a in names and b in names]
+        for k, pair in enumerate(sp.pulse_antagonists):
+            bad = [m for m in pair if m not in names]
+            if bad:
+                raise ArticError(f"speech.pulse_antagonists[{k}]: '{bad[0]}' is not a muscle or group; valid: "
+                                 f"{', '.join(names)}")
+        pairs = [(muscle_shares(model, a), muscle_shares(model, b)) for a, b in sp.pulse_antagonists]
         starts, sets = pulse_step(p.starts_s, p.durations_s, vectors, units.ms_to_s(sp.pulse_ms), sp.pulse_gain,
                                   units.newton_to_dyn(view.muscles.max_force_n), pairs)
     force_at = course(starts, sets, ramp_s)

@@ -186,6 +186,17 @@ def test_a_jaw_pulse_below_zero_drives_the_closers():
     assert plain[2].tolist() == [0.0, 0.0, 0.0]  # without the pair the pulse is clipped at zero
 
 
+def test_an_unknown_antagonist_is_one_line_naming_the_key_and_writes_nothing(tmp_path, mesh_file):
+    d = yaml.safe_load((ROOT / "configs" / "default.yaml").read_text())
+    d["speech"]["pulse_antagonists"] = [["JO", "XX"]]
+    cfg = _write(tmp_path / "cfg.yaml", d)
+    u = _write(tmp_path / "u.yaml", {"force_course": "pulse_step", "segments": [A]})
+    res = _run("speak", u, "--mesh", mesh_file, "--config", cfg, "--out", tmp_path / "out" / "u.wav")
+    assert res.exit_code == 2 and "speech.pulse_antagonists[0]" in res.output and "'XX'" in res.output, res.output
+    assert len([ln for ln in res.output.splitlines() if ln.strip()]) == 1
+    assert not (tmp_path / "out").exists()
+
+
 def test_a_lead_switches_each_segment_s_forces_on_before_its_sound(tmp_path, mesh_file):
     doc = {"name": "lead", "force_course": "static", "f0_hz": [[0.0, 120]],
            "segments": [{"forces_n": {"JO": 2.5}, "duration_ms": 150, "label": "a"},
