@@ -2,22 +2,22 @@
 rate, driven at the glottis by the LF flow derivative, radiating at the lips.
 
 The tract is cut into N sections of equal length c / fs_internal, so that a wave crosses one section per
-sample; area changes between frames are interpolated sample by sample.  At each junction the pressure
-waves scatter with r = (A_k - A_k+1) / (A_k + A_k+1); |r| <= 1 for every area, so a closure (area 0, held at
-0.01 mm^2) reflects the wave whole and stays stable: silence behind it, a release when it opens.  The
-glottis end reflects with ``glottal_reflection`` (nearly closed).  The lips reflect through the same
-radiation load as the frequency-domain model (a piston in a baffle, parallel R-L), as a first-order filter
-(bilinear transform of (Z - Zc) / (Z + Zc), Zc = rho c / A_lips): -1 at low frequencies, with the end
-correction that lowers the formants of a wide mouth.  Yielding walls, as the transfer function has them (mass,
-resistance and stiffness per unit area; Ishizaka et al. 1975's form): at each junction a patch of wall, the
+sample; area changes between frames are interpolated sample by sample.  Each junction has one pressure,
+2 sum(A p_in) / sum(A) over the tubes that meet there, and each tube's outgoing wave is that pressure less
+its incoming one: between two sections the scattering r = (A_k - A_k+1) / (A_k + A_k+1), |r| <= 1 for every
+area, so a closure (area 0, held at 0.01 mm^2) reflects the wave whole and stays stable: silence behind it,
+a release when it opens.  A closed side branch (the piriform fossae, as the transfer function has them)
+joins at a three-tube junction.  Yielding walls, as the transfer function has them (mass, resistance and
+stiffness per unit area; Ishizaka et al. 1975's form): at each two-tube junction a patch of wall, the
 perimeter 2 sqrt(pi A) times a section's length, moves under the junction pressure and takes its volume
 velocity from the junction's flow (the wall's velocity and the junction's pressure solved together, a
-backward-Euler step).  Each section passes ``1 - section_loss`` of a wave (boundary-layer losses lumped).
-A closed side branch (the piriform fossae, as the transfer function has them) joins at a three-tube junction: one pressure 2 sum(A p_in) / sum(A), each tube's
-outgoing wave that pressure less its incoming one.  Turbulence noise
-(frication, bursts) enters as a series pressure source at a junction, half its pressure sent each way.  The
-radiated sound is the time derivative of the lips' volume velocity, brought to the audio rate by a polyphase
-filter.
+backward-Euler step).  The glottis end reflects with ``glottal_reflection`` (nearly closed).  The lips
+reflect through the same radiation load as the frequency-domain model (a piston in a baffle, parallel R-L),
+as a first-order filter (bilinear transform of (Z - Zc) / (Z + Zc), Zc = rho c / A_lips): -1 at low
+frequencies, with the end correction that lowers the formants of a wide mouth.  Each section passes
+``1 - section_loss`` of a wave (boundary-layer losses lumped).  Turbulence noise (frication, bursts) enters
+as a series pressure source at a junction, half its pressure sent each way.  The radiated sound is the time
+derivative of the lips' volume velocity, brought to the audio rate by a polyphase filter.
 """
 
 from __future__ import annotations
@@ -66,30 +66,24 @@ def _line(frame_areas, frame_index, source, glottal_reflection, rho, c, fs, loss
             a = (1.0 - w) * frame_areas[k0, j] + (w * frame_areas[k0 + 1, j] if frame_areas.shape[0] > 1 else 0.0)
             area[j] = a if a > 1e-4 else 1e-4
         new_f[0] = glottal_reflection * bwd[0] + source[s] / area[0]
-        for j in range(n - 1):
-            if j == branch_at:  # three tubes meet: one junction pressure, each tube's outgoing wave from it
-                a3 = branch_areas[0]
-                pj = 2.0 * (area[j] * fwd[j] + area[j + 1] * bwd[j + 1] + a3 * bb[0]) / (area[j] + area[j + 1] + a3)
-                new_f[j + 1] = pj - bwd[j + 1]
-                new_b[j] = pj - fwd[j]
-                new_bf[0] = pj - bb[0]
-                continue
-            if walls:  # the junction's flow less what its wall patch takes: p / (rho c) = f + b, U = A (f - b)
-                patch = 2.0 * np.sqrt(pi * 0.5 * (area[j] + area[j + 1])) * dx
-                a_sum = area[j] + area[j + 1]
-                into = 2.0 * (area[j] * fwd[j] + area[j + 1] * bwd[j + 1])
-                # the wall's velocity and the junction's pressure solved together (backward Euler): stable for
-                # any area, a closure's slit included
+        for j in range(n - 1):  # each junction's pressure p / (rho c) = f + b from the flows U = A (f - b) into it
+            a_sum = area[j] + area[j + 1]
+            into = 2.0 * (area[j] * fwd[j] + area[j + 1] * bwd[j + 1])
+            if j == branch_at:  # three tubes meet: the side branch's flow joins
+                a_sum += branch_areas[0]
+                into += 2.0 * branch_areas[0] * bb[0]
+            elif walls:  # less what the junction's wall patch takes; the wall's velocity and the pressure solved
+                # together (backward Euler): stable for any area, a closure's slit included
+                patch = 2.0 * np.sqrt(pi * 0.5 * a_sum) * dx
                 wall_v[j] = ((wall_m / dt) * wall_v[j] + rho * c * into / a_sum - wall_k * wall_x[j]) / (
                     wall_m / dt + rho * c * patch / a_sum + wall_r + wall_k * dt)
                 wall_x[j] += dt * wall_v[j]
-                pj = (into - patch * wall_v[j]) / a_sum
-                new_f[j + 1] = pj - bwd[j + 1]
-                new_b[j] = pj - fwd[j]
-                continue
-            r = (area[j] - area[j + 1]) / (area[j] + area[j + 1])
-            new_f[j + 1] = (1.0 + r) * fwd[j] - r * bwd[j + 1]
-            new_b[j] = r * fwd[j] + (1.0 - r) * bwd[j + 1]
+                into -= patch * wall_v[j]
+            pj = into / a_sum
+            new_f[j + 1] = pj - bwd[j + 1]
+            new_b[j] = pj - fwd[j]
+            if j == branch_at:
+                new_bf[0] = pj - bb[0]
         k_n = noise_at[s]
         if 0 <= k_n < n - 1:  # a series pressure source between sections k_n and k_n + 1: half each way
             half = 0.5 * noise[s] / (rho * c)
