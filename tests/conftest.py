@@ -17,6 +17,16 @@ ROOT = Path(__file__).resolve().parent.parent
 LONGEST_FIRST = ("test_pipeline.py", "test_solver.py", "test_epmap.py")  # the modules that take longest
 
 
+def praat_formants_near(wav, times, expected) -> tuple[list[float], list[float]]:
+    """Praat (Burg: 5 formants below 5 kHz, 25-ms windows) on a WAV: each formant's median over ``times``, and
+    for each ``expected`` value the one nearest it (Burg may insert spurious peaks, so not by index)."""
+    parselmouth = pytest.importorskip("parselmouth")
+    fm = parselmouth.Sound(str(wav)).to_formant_burg(0.01, 5, 5000, 0.025, 50)
+    found = [f for f in (np.nanmedian([fm.get_value_at_time(j, t) for t in times]) for j in range(1, 6))
+             if np.isfinite(f)]
+    return [min(found, key=lambda f: abs(f - e)) for e in expected], found
+
+
 def pytest_collection_modifyitems(items):
     """The longest modules first, so that two workers (``-n 2 --dist loadfile``) finish together."""
     rank = {name: i for i, name in enumerate(LONGEST_FIRST)}
