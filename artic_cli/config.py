@@ -427,6 +427,9 @@ class Speech(Strict):
     # each segment's muscle forces switch on this long before its sound starts (the first at t = 0): speech
     # muscles' EMG leads the acoustic event (0: at the segment's start, as the paper's controller switches them)
     lead_ms: Annotated[float, Field(ge=0, le=300, allow_inf_nan=False)] = 0.0
+    # the first segment's forces switch on this long before the sound, in silence (at least lead_ms): a speaker
+    # sets the articulators before voicing starts; 0 = lead_ms
+    prepare_ms: Annotated[float, Field(ge=0, le=1000, allow_inf_nan=False)] = 0.0
     # the muscles' force follows the course with first-order activation dynamics, rising and falling with these
     # time constants (beyond the paper, whose forces follow their commands at once: 0, 0)
     activation_rise_ms: Annotated[float, Field(ge=0, le=200, allow_inf_nan=False)] = 0.0

@@ -6,6 +6,7 @@ Example::
     f0_hz: [[0.0, 125], [0.6, 100]]      # [time_s, F0 Hz] points, times rising; between them linear
     ramp_ms: 30                          # optional: each target's forces ramp in over this (config speech.ramp_ms)
     lead_ms: 80                          # optional: ... starting this long before the segment (config speech.lead_ms)
+    prepare_ms: 250                      # optional: the first segment's, this long before the sound (speech.prepare_ms)
     force_course: static                 # optional: or pulse_step (config speech.force_course)
     segments:
       - {target: configs/targets/vowels/a.yaml, duration_ms: 250}
@@ -55,6 +56,7 @@ class Utterance(Strict):
         [[0.0, 120.0]]
     ramp_ms: Annotated[float, Field(ge=0, le=500, allow_inf_nan=False)] | None = None
     lead_ms: Annotated[float, Field(ge=0, le=300, allow_inf_nan=False)] | None = None  # else speech.lead_ms
+    prepare_ms: Annotated[float, Field(ge=0, le=1000, allow_inf_nan=False)] | None = None  # else speech.prepare_ms
     force_course: Literal["static", "pulse_step"] | None = None  # the config's speech.force_course otherwise
     tract: list[TractEntry] = []
 

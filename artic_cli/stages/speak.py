@@ -84,6 +84,7 @@ class Spoken:
     ramp_ms: float  # each segment's ramp
     activation_ms: tuple[float, float]  # the muscles' activation rise and fall time constants (0, 0: none)
     lead_ms: float = 0.0  # each segment's forces switch on this long before its sound
+    prepare_ms: float = 0.0  # the first segment's forces switch on this long before the sound (>= lead_ms)
 
 
 # --- the plan: targets -> forces ---------------------------------------------------------------------
@@ -284,7 +285,14 @@ def compute(u: Utterance, p: Plan, cfg: Config, mesh, wall, progress=None, model
     # the course runs on a clock that starts ``lead`` before the sound: every segment's forces switch on
     # ``lead`` before its sound, the first one's during a silent lead-in that the record leaves out
     lead = units.ms_to_s(sp.lead_ms if u.lead_ms is None else u.lead_ms)
-    starts, sets = p.starts_s, vectors
+    # the first segment's forces may switch on earlier still (a speaker sets the articulators before voicing):
+    # the course's clock then starts ``prep`` before the sound, its first segment lengthened by the difference
+    prep = max(lead, units.ms_to_s(sp.prepare_ms if u.prepare_ms is None else u.prepare_ms))
+    starts = np.asarray(p.starts_s, float) + (prep - lead)
+    starts[0] = 0.0
+    durations = np.asarray(p.durations_s, float).copy()
+    durations[0] += prep - lead
+    sets = vectors
     if how == "pulse_step":
         for k, pair in enumerate(sp.pulse_antagonists):
             bad = [m for m in pair if m not in names]
@@ -292,12 +300,12 @@ def compute(u: Utterance, p: Plan, cfg: Config, mesh, wall, progress=None, model
                 raise ArticError(f"speech.pulse_antagonists[{k}]: '{bad[0]}' is not a muscle or group; valid: "
                                  f"{', '.join(names)}")
         pairs = [(muscle_shares(model, a), muscle_shares(model, b)) for a, b in sp.pulse_antagonists]
-        starts, sets = pulse_step(p.starts_s, p.durations_s, vectors, units.ms_to_s(sp.pulse_ms), sp.pulse_gain,
+        starts, sets = pulse_step(starts, durations, vectors, units.ms_to_s(sp.pulse_ms), sp.pulse_gain,
                                   units.newton_to_dyn(view.muscles.max_force_n), pairs)
     force_at = course(starts, sets, ramp_s)
     duration = float(p.starts_s[-1] + p.durations_s[-1])
     if sp.activation_rise_ms > 0 or sp.activation_fall_ms > 0:
-        force_at = activated(force_at, duration + lead, units.ms_to_s(sp.activation_rise_ms),
+        force_at = activated(force_at, duration + prep, units.ms_to_s(sp.activation_rise_ms),
                              units.ms_to_s(sp.activation_fall_ms))
     zero = np.zeros((model.n_nodes, 3))
     clock = [time.perf_counter()]
@@ -314,12 +322,12 @@ def compute(u: Utterance, p: Plan, cfg: Config, mesh, wall, progress=None, model
     eps = equilibria(model, rest, vectors, units.ms_to_s(sp.reach_hold_ms), dt)
     lap("segment EPs")
     start = rest
-    if lead > 0:  # the lead-in: the first segment's forces act before the sound starts
-        _, start = run(model, rest, lambda t: Control(node_force=zero, muscle_force=force_at(t)), lead, dt)
+    if prep > 0:  # the lead-in: the first segment's forces act before the sound starts
+        _, start = run(model, rest, lambda t: Control(node_force=zero, muscle_force=force_at(t)), prep, dt)
         start = replace(start, t=0.0)
         lap("lead-in")
     every = max(1, int(round(units.ms_to_s(sp.frame_ms) / dt)))
-    traj, _ = run(model, start, lambda t: Control(node_force=zero, muscle_force=force_at(t + lead)), duration, dt,
+    traj, _ = run(model, start, lambda t: Control(node_force=zero, muscle_force=force_at(t + prep)), duration, dt,
                   record_every=every, progress=progress, keep_partial=True)
     lap("simulation")
     beyond = 0.0
@@ -368,13 +376,14 @@ def compute(u: Utterance, p: Plan, cfg: Config, mesh, wall, progress=None, model
                                      flow_peak_cm3_s=sp.glottal_flow_peak_cm3_s, noise=noise)
     lap("sound")
     cps = {name: traj.x[:, idx] for name, idx in model.control_points().items()}
-    commanded = np.array([force_at(float(t) + lead) for t in traj.time])
+    commanded = np.array([force_at(float(t) + prep) for t in traj.time])
     return Spoken(utterance=u, plan=p, trajectory=traj, tracts=tracts, formants_hz=formants_hz, noise=tb,
                   glottis_cm2=glottis, audio=audio, control_points=cps, muscle_names=list(model.muscle_names),
                   muscle_force_n=units.dyn_to_newton(commanded), timings_s=timings, segment_eps_cm=eps,
                   beyond_wall_cm=beyond,
                   force_course=how, ramp_ms=units.s_to_ms(ramp_s),
-                  activation_ms=(sp.activation_rise_ms, sp.activation_fall_ms), lead_ms=units.s_to_ms(lead))
+                  activation_ms=(sp.activation_rise_ms, sp.activation_fall_ms), lead_ms=units.s_to_ms(lead),
+                  prepare_ms=units.s_to_ms(prep))
 
 
 # --- files ---------------------------------------------------------------------------------------------
@@ -426,6 +435,7 @@ def write(wav: Path | str, s: Spoken, prov=None) -> dict[str, Path]:
         g.attrs["ramp_ms"] = s.ramp_ms
         g.attrs["activation_ms"] = np.asarray(s.activation_ms, float)
         g.attrs["lead_ms"] = s.lead_ms
+        g.attrs["prepare_ms"] = s.prepare_ms
         g.create_dataset("lip_area", data=np.array([a for a, _ in p.lips])).attrs["units"] = "cm^2"
         g.create_dataset("lip_length", data=np.array([b for _, b in p.lips])).attrs["units"] = "cm"
         names = sorted({m for f_ in p.forces_n for m in f_})
@@ -487,6 +497,7 @@ class Record:
     ramp_ms: float
     activation_ms: tuple[float, float]
     lead_ms: float = 0.0
+    prepare_ms: float = 0.0
 
 
 def read(path: Path | str) -> Record:
@@ -504,7 +515,8 @@ def read(path: Path | str) -> Record:
                           force_course=str(g.attrs.get("force_course", "static")),
                           ramp_ms=float(g.attrs.get("ramp_ms", 30.0)),
                           activation_ms=tuple(float(v) for v in g.attrs.get("activation_ms", (0.0, 0.0))),
-                          lead_ms=float(g.attrs.get("lead_ms", 0.0)))
+                          lead_ms=float(g.attrs.get("lead_ms", 0.0)),
+                          prepare_ms=float(g.attrs.get("prepare_ms", g.attrs.get("lead_ms", 0.0))))
         except (KeyError, ValueError, OSError) as err:
             raise ArticError(f"{path} is damaged or incomplete ({type(err).__name__}); {STAGE.hint}") from None
 

@@ -72,7 +72,7 @@ def test_the_air_stops_at_a_closure_and_is_turbulent_in_a_narrow_channel():
                                                                        1800.0, 0.05)
 
 
-LAB = {"name": "lab", "f0_hz": [[0.0, 125], [0.75, 100]], "force_course": "static", "lead_ms": 0,
+LAB = {"name": "lab", "f0_hz": [[0.0, 125], [0.75, 100]], "force_course": "static", "lead_ms": 0, "prepare_ms": 0,
        "segments": [dict(A, duration_ms=200), {"forces_n": {"JO": 0.5}, "duration_ms": 100, "label": "p",
                                                  "voiced": False},
                     dict(A), {"forces_n": {"JO": 0.5}, "duration_ms": 150, "label": "f", "voiced": False},
@@ -198,7 +198,7 @@ def test_an_unknown_antagonist_is_one_line_naming_the_key_and_writes_nothing(tmp
 
 
 def test_a_lead_switches_each_segment_s_forces_on_before_its_sound(tmp_path, mesh_file):
-    doc = {"name": "lead", "force_course": "static", "f0_hz": [[0.0, 120]],
+    doc = {"name": "lead", "force_course": "static", "f0_hz": [[0.0, 120]], "prepare_ms": 0,
            "segments": [{"forces_n": {"JO": 2.5}, "duration_ms": 150, "label": "a"},
                         {"forces_n": {"GGp": 2.0}, "duration_ms": 150, "label": "i"}]}
     recs = {}
@@ -221,6 +221,28 @@ def test_a_lead_switches_each_segment_s_forces_on_before_its_sound(tmp_path, mes
     jaw = lambda rec: rec.control_points["jaw"][:, 1]  # noqa: E731
     assert jaw(ahead)[0] < jaw(now)[0] - 0.1  # the jaw already opening when the sound starts
     assert len(t) == len(t0) and t[0] == pytest.approx(0.0)
+
+
+def test_preparing_switches_only_the_first_segment_s_forces_on_earlier(tmp_path, mesh_file):
+    doc = {"name": "prep", "force_course": "static", "f0_hz": [[0.0, 120]], "lead_ms": 50,
+           "segments": [{"forces_n": {"JO": 2.5}, "duration_ms": 150, "label": "a"},
+                        {"forces_n": {"GGp": 2.0}, "duration_ms": 150, "label": "i"}]}
+    recs = {}
+    for prep in (0, 250):
+        u = _write(tmp_path / f"prep{prep}.yaml", dict(doc, prepare_ms=prep))
+        res = _run("speak", u, "--mesh", mesh_file, "--out", tmp_path / f"prep{prep}.wav")
+        assert res.exit_code == 0, res.output
+        recs[prep] = speak.read(tmp_path / f"prep{prep}.h5")
+    lead, prepared = recs[0], recs[250]
+    assert lead.prepare_ms == 50.0 and prepared.prepare_ms == 250.0  # never less than the lead
+    jaw = lambda rec: rec.control_points["jaw"][:, 1]  # noqa: E731
+    assert jaw(prepared)[0] < jaw(lead)[0] - 0.1  # the jaw 250 ms into its opening when the sound starts
+    at = lambda rec, x: rec.commanded_n[np.searchsorted(rec.time_s, x)]  # noqa: E731
+    # the second segment's forces still switch on 50 ms before its sound (0.10 s), in both (the first's JO
+    # differs by its activation's last 0.03 %: 50 ms of rise against 300)
+    np.testing.assert_allclose(at(prepared, 0.09), at(lead, 0.09), atol=1e-3)
+    np.testing.assert_allclose(at(prepared, 0.11), at(lead, 0.11), atol=1e-3)
+    assert not np.allclose(at(lead, 0.09), at(lead, 0.11))
 
 
 def test_an_unreachable_target_exits_3_naming_its_segment_and_writes_nothing(tmp_path, mesh_file):
