@@ -11,7 +11,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from ..mechanics.contact import farthest_beyond_wall, wall_query
+from ..geometry.wall import PARTS
+from ..mechanics.contact import closest_on_triangles, farthest_beyond_wall, wall_query
 from ..mechanics.jaw_hold import fresh_start, hold_jaw
 from ..mechanics.loads import control_from_newtons
 from ..mechanics.model import Model
@@ -138,9 +139,27 @@ def muscle_directions(model: Model, force: float = 4.0, duration: float = 0.3, h
     return rows + audit.rows()
 
 
+def touching(model: Model, traj, end, part: str) -> dict[int, np.ndarray]:
+    """{node: end position (cm)} of the nodes a run had in contact whose nearest wall triangle (at the end)
+    belongs to ``part`` (palate, pharynx or mandible)."""
+    cor, out = model.contact.corners, {}
+    for c in sorted({int(c) for cs in traj.contact_nodes for c in cs}):
+        q = closest_on_triangles(np.repeat(end.x[c][None], len(cor), 0), cor[:, 0], cor[:, 1], cor[:, 2])
+        if PARTS[model.contact.wall.part[int(np.argmin(np.linalg.norm(q - end.x[c], axis=1)))]] == part:
+            out[c] = end.x[c]
+    return out
+
+
+BLADE_FORCES = {"GGp": 4.0, "SL": 2.0, "T": 2.0}  # a set at 4 N or less that raises the blade to the ridge
+ALVEOLAR_X = -1.6  # cm: the palate within this far behind the upper incisor edge is the alveolar ridge
+TIP_FORCES = {"GGa": 2.0}  # GGa pulls the tip down behind the lower incisors
+
+
 def k_closure(model: Model, forces=(0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0, 4.0), duration: float = 0.3,
-              hold: bool = False) -> list[Row]:
-    """Smallest SG force at which the dorsum region touches the palate (jaw at rest; ``hold``: held there)."""
+              hold: bool = False, reach: bool = True) -> list[Row]:
+    """Smallest SG force at which the dorsum region touches the palate (jaw at rest; ``hold``: held there);
+    with ``reach``, also whether the blade reaches the alveolar ridge (:data:`BLADE_FORCES`) and the tip the
+    lower incisors' lingual side (:data:`TIP_FORCES`), each held for ``duration`` from rest."""
     rest = settle(model)
     dorsum_region = set(model.node_sets["dorsum_region"].tolist())
     dorsum = model.control_points()["dorsum"]
@@ -153,8 +172,22 @@ def k_closure(model: Model, forces=(0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0, 4.0), d
             break
         gap = float(-wall_query(model.contact, end.x, np.array([dorsum]))[2][0])
     note = "" if found is not None else f"no contact up to {forces[-1]:g} N; dorsum still {gap:.2f} cm from the wall"
-    return [Row("SG force at first dorsum-palate contact", float("nan") if found is None else found, 1.0, "N",
-                note)] + audit.rows()
+    rows = [Row("SG force at first dorsum-palate contact", float("nan") if found is None else found, 1.0, "N", note)]
+    if reach:
+        sets = ", ".join(f"{m} {f:g} N" for m, f in BLADE_FORCES.items())
+        traj, end = audit.run(rest, BLADE_FORCES, duration, hold)
+        on = {n: p for n, p in touching(model, traj, end, "palate").items() if p[0] > ALVEOLAR_X}
+        blade = set(model.node_sets["blade"].tolist())
+        note = (f"{sets}: " + (", ".join(f"node {n} at ({p[0]:.2f}, {p[1]:.2f}, {p[2]:.2f})" for n, p in on.items())
+                               if on else "none") + f" (alveolar: x > {ALVEOLAR_X:g} cm)")
+        rows.append(Row("blade nodes on the alveolar ridge", float(len(blade & set(on))), None, "count", note))
+        tip = model.control_points()["tip"]
+        traj, end = audit.run(rest, TIP_FORCES, duration, hold)
+        on = touching(model, traj, end, "mandible")
+        sets = ", ".join(f"{m} {f:g} N" for m, f in TIP_FORCES.items())
+        note = f"{sets}: tip at ({end.x[tip, 0]:.2f}, {end.x[tip, 1]:.2f}) cm; {len(on)} node(s) on the mandible"
+        rows.append(Row("tip on the lower incisors' lingual side", float(tip in on), 1.0, "bool", note))
+    return rows + audit.rows()
 
 
 def stress(model: Model, force: float = 7.0, duration: float = 0.5) -> list[Row]:

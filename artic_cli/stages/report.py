@@ -137,6 +137,16 @@ def articulator_rows(data: Path) -> list[Row]:
     rows.append(Row("SG force at which the dorsum first touches the palate (jaw at rest)", "about 1.0 N",
                     "none up to 4 N" if r["ours"] is None else f"{r['ours']:g} N",
                     _verdict(r["ours"] is not None and 0.5 <= r["ours"] <= 2.0, r["note"] or "goal about 1 N")))
+    for key, item, what in (("blade nodes on the alveolar ridge", "The blade on the alveolar ridge with a muscle set "
+                             "at 4 N or less (jaw at rest)", "blade node(s) on it"),
+                            ("tip on the lower incisors' lingual side", "The tip on the lower incisors' lingual "
+                             "side with GGa (jaw at rest)", "")):
+        r = kc.get(key)
+        if r is None:  # an experiment file from before these rows
+            continue
+        n = r["ours"] or 0.0
+        ours = (f"{n:g} {what}" if what else ("yes" if n else "no")) + "; " + r["note"].split(":")[0]
+        rows.append(Row(item, "reached (goal)", ours, _verdict(n >= 1, r["note"])))
     st = _experiment(data, "stress")
     ok, detail = _audit_ok(st)
     rows.append(Row("7 N on GGp, SG, HG, SL, IL at once for 500 ms", "no divergence",
