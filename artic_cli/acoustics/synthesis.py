@@ -23,11 +23,22 @@ derivative of the lips' volume velocity, brought to the audio rate by a polyphas
 from __future__ import annotations
 
 import numpy as np
-from scipy.signal import lfilter
 
 from ..mechanics.kernels import njit
 
 MIN_AREA_CM2 = 1e-4
+
+
+@njit(cache=True)
+def _leaky_integral(x, gain, keep):
+    """y[n] = gain x[n] + keep y[n-1]: a first-order recursive filter (scipy.signal.lfilter([gain], [1, -keep])
+    without importing scipy.signal, 2.6 s per process)."""
+    y = np.empty_like(x)
+    acc = 0.0
+    for k in range(len(x)):
+        acc = gain * x[k] + keep * acc
+        y[k] = acc
+    return y
 
 
 @njit(cache=True)
@@ -166,7 +177,7 @@ def synthesize(frame_areas: np.ndarray, frame_times_s: np.ndarray, source: np.nd
     t = np.arange(len(source)) / fs_internal
     index = np.interp(t, frame_times_s, np.arange(len(frame_times_s))) if len(frame_times_s) > 1 else np.zeros(len(t))
     # the source drives flow: integrate its derivative (leaky, so no drift) before it enters the line
-    flow = lfilter([1.0 / fs_internal], [1.0, -0.999], source)
+    flow = _leaky_integral(np.ascontiguousarray(source, dtype=float), 1.0 / fs_internal, 0.999)
     peak = float(np.max(np.abs(flow))) if len(flow) else 0.0
     flow = flow * (flow_peak_cm3_s / peak if flow_peak_cm3_s is not None and peak > 0 else 1e4)
     at, areas = (-1, np.zeros(0)) if branch is None else (int(branch[0]), np.asarray(branch[1], dtype=float))

@@ -10,7 +10,6 @@ from typing import Annotated
 import numpy as np
 from pydantic import Field
 from scipy.io import wavfile
-from scipy.signal import resample_poly
 
 from ..acoustics.source import lf_flow_derivative
 from ..acoustics.model import tract_of
@@ -100,6 +99,8 @@ def compute_frames(lengths_cm: np.ndarray, areas_cm2: np.ndarray, times_s: np.nd
                    sy.section_loss, ac.air_density_g_cm3, ac.sound_speed_cm_s, branch, flow_peak_cm3_s, pn,
                    (ac.wall_mass_g_cm2, ac.wall_resistance_dyn_s_cm3, ac.wall_stiffness_dyn_cm3)
                    if ac.yielding_walls else None)
+    from scipy.signal import resample_poly  # here: importing scipy.signal takes 2.6 s, only a voice needs it
+
     y = resample_poly(y, 1, 2)
     peak = float(np.max(np.abs(y))) if len(y) else 0.0
     return Audio(0.9 * y / peak if peak > 0 else y, sy.sample_rate_hz)
