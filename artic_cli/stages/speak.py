@@ -282,11 +282,10 @@ def compute(u: Utterance, p: Plan, cfg: Config, mesh, wall, progress=None, model
     vectors = np.array([muscle_force_vector(model, f) for f in p.forces_n])
     ramp_s = units.ms_to_s(sp.ramp_ms if u.ramp_ms is None else u.ramp_ms)
     how = sp.force_course if u.force_course is None else u.force_course
-    # the course runs on a clock that starts ``lead`` before the sound: every segment's forces switch on
-    # ``lead`` before its sound, the first one's during a silent lead-in that the record leaves out
+    # every segment's forces switch on ``lead`` before its sound; the first one's ``prep`` (>= lead) before it,
+    # during a silent lead-in that the record leaves out (a speaker sets the articulators before voicing): the
+    # course's clock starts ``prep`` before the sound, its first segment lengthened by ``prep - lead``
     lead = units.ms_to_s(sp.lead_ms if u.lead_ms is None else u.lead_ms)
-    # the first segment's forces may switch on earlier still (a speaker sets the articulators before voicing):
-    # the course's clock then starts ``prep`` before the sound, its first segment lengthened by the difference
     prep = max(lead, units.ms_to_s(sp.prepare_ms if u.prepare_ms is None else u.prepare_ms))
     starts = np.asarray(p.starts_s, float) + (prep - lead)
     starts[0] = 0.0
