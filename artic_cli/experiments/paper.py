@@ -155,6 +155,10 @@ ALVEOLAR_X = -1.6  # cm: the palate within this far behind the upper incisor edg
 TIP_FORCES = {"GGa": 2.0}  # GGa pulls the tip down behind the lower incisors
 
 
+def _listed(forces: dict[str, float]) -> str:
+    return ", ".join(f"{m} {f:g} N" for m, f in forces.items())
+
+
 def k_closure(model: Model, forces=(0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0, 4.0), duration: float = 0.3,
               hold: bool = False, reach: bool = True) -> list[Row]:
     """Smallest SG force at which the dorsum region touches the palate (jaw at rest; ``hold``: held there);
@@ -174,18 +178,16 @@ def k_closure(model: Model, forces=(0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0, 4.0), d
     note = "" if found is not None else f"no contact up to {forces[-1]:g} N; dorsum still {gap:.2f} cm from the wall"
     rows = [Row("SG force at first dorsum-palate contact", float("nan") if found is None else found, 1.0, "N", note)]
     if reach:
-        sets = ", ".join(f"{m} {f:g} N" for m, f in BLADE_FORCES.items())
         traj, end = audit.run(rest, BLADE_FORCES, duration, hold)
         on = {n: p for n, p in touching(model, traj, end, "palate").items() if p[0] > ALVEOLAR_X}
         blade = set(model.node_sets["blade"].tolist())
-        note = (f"{sets}: " + (", ".join(f"node {n} at ({p[0]:.2f}, {p[1]:.2f}, {p[2]:.2f})" for n, p in on.items())
+        note = (f"{_listed(BLADE_FORCES)}: " + (", ".join(f"node {n} at ({p[0]:.2f}, {p[1]:.2f}, {p[2]:.2f})" for n, p in on.items())
                                if on else "none") + f" (alveolar: x > {ALVEOLAR_X:g} cm)")
         rows.append(Row("blade nodes on the alveolar ridge", float(len(blade & set(on))), None, "count", note))
         tip = model.control_points()["tip"]
         traj, end = audit.run(rest, TIP_FORCES, duration, hold)
         on = touching(model, traj, end, "mandible")
-        sets = ", ".join(f"{m} {f:g} N" for m, f in TIP_FORCES.items())
-        note = f"{sets}: tip at ({end.x[tip, 0]:.2f}, {end.x[tip, 1]:.2f}) cm; {len(on)} node(s) on the mandible"
+        note = f"{_listed(TIP_FORCES)}: tip at ({end.x[tip, 0]:.2f}, {end.x[tip, 1]:.2f}) cm; {len(on)} node(s) on the mandible"
         rows.append(Row("tip on the lower incisors' lingual side", float(tip in on), 1.0, "bool", note))
     return rows + audit.rows()
 

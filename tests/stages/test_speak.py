@@ -197,52 +197,58 @@ def test_an_unknown_antagonist_is_one_line_naming_the_key_and_writes_nothing(tmp
     assert not (tmp_path / "out").exists()
 
 
-def test_a_lead_switches_each_segment_s_forces_on_before_its_sound(tmp_path, mesh_file):
-    doc = {"name": "lead", "force_course": "static", "f0_hz": [[0.0, 120]], "prepare_ms": 0,
-           "segments": [{"forces_n": {"JO": 2.5}, "duration_ms": 150, "label": "a"},
-                        {"forces_n": {"GGp": 2.0}, "duration_ms": 150, "label": "i"}]}
+# a jaw opening then a GGp push, forces held (static), for the lead and preparation tests
+OPEN_THEN_PUSH = {"force_course": "static", "f0_hz": [[0.0, 120]],
+                  "segments": [{"forces_n": {"JO": 2.5}, "duration_ms": 150, "label": "a"},
+                               {"forces_n": {"GGp": 2.0}, "duration_ms": 150, "label": "i"}]}
+
+
+def _spoken_with(tmp_path, mesh_file, doc: dict, key: str, values) -> dict:
+    """{value: record} of ``doc`` spoken once for each value of its ``key``."""
     recs = {}
-    for lead in (0, 100):
-        u = _write(tmp_path / f"lead{lead}.yaml", dict(doc, lead_ms=lead))
-        res = _run("speak", u, "--mesh", mesh_file, "--out", tmp_path / f"lead{lead}.wav")
+    for value in values:
+        u = _write(tmp_path / f"{key}{value}.yaml", dict(doc, name=f"{key}{value}", **{key: value}))
+        res = _run("speak", u, "--mesh", mesh_file, "--out", tmp_path / f"{key}{value}.wav")
         assert res.exit_code == 0, res.output
-        recs[lead] = speak.read(tmp_path / f"lead{lead}.h5")
+        recs[value] = speak.read(tmp_path / f"{key}{value}.h5")
+    return recs
+
+
+def _commanded_at(rec, t_s: float) -> np.ndarray:
+    return rec.commanded_n[np.searchsorted(rec.time_s, t_s)]
+
+
+def _jaw_height(rec) -> np.ndarray:
+    return rec.control_points["jaw"][:, 1]
+
+
+def test_a_lead_switches_each_segment_s_forces_on_before_its_sound(tmp_path, mesh_file):
+    recs = _spoken_with(tmp_path, mesh_file, dict(OPEN_THEN_PUSH, prepare_ms=0), "lead_ms", (0, 100))
     now, ahead = recs[0], recs[100]
     assert ahead.lead_ms == 100.0 and now.lead_ms == 0.0
     import h5py
 
-    with h5py.File(tmp_path / "lead100.h5") as f:
+    with h5py.File(tmp_path / "lead_ms100.h5") as f:
         names = [str(n) for n in f["muscles"].attrs["names"]]
     ggp = [k for k, n in enumerate(names) if n.startswith("GGp")]
     t, t0 = ahead.time_s, now.time_s
-    at = lambda rec, x: rec.commanded_n[np.searchsorted(rec.time_s, x)]  # noqa: E731
-    assert at(ahead, 0.14)[ggp].sum() > 1.9  # GGp's segment starts at 0.15 s, its forces at 0.05 s
-    assert at(now, 0.14)[ggp].sum() == 0.0
-    jaw = lambda rec: rec.control_points["jaw"][:, 1]  # noqa: E731
-    assert jaw(ahead)[0] < jaw(now)[0] - 0.1  # the jaw already opening when the sound starts
+    assert _commanded_at(ahead, 0.14)[ggp].sum() > 1.9  # GGp's segment starts at 0.15 s, its forces at 0.05 s
+    assert _commanded_at(now, 0.14)[ggp].sum() == 0.0
+    assert _jaw_height(ahead)[0] < _jaw_height(now)[0] - 0.1  # the jaw already opening when the sound starts
     assert len(t) == len(t0) and t[0] == pytest.approx(0.0)
 
 
 def test_preparing_switches_only_the_first_segment_s_forces_on_earlier(tmp_path, mesh_file):
-    doc = {"name": "prep", "force_course": "static", "f0_hz": [[0.0, 120]], "lead_ms": 50,
-           "segments": [{"forces_n": {"JO": 2.5}, "duration_ms": 150, "label": "a"},
-                        {"forces_n": {"GGp": 2.0}, "duration_ms": 150, "label": "i"}]}
-    recs = {}
-    for prep in (0, 250):
-        u = _write(tmp_path / f"prep{prep}.yaml", dict(doc, prepare_ms=prep))
-        res = _run("speak", u, "--mesh", mesh_file, "--out", tmp_path / f"prep{prep}.wav")
-        assert res.exit_code == 0, res.output
-        recs[prep] = speak.read(tmp_path / f"prep{prep}.h5")
+    recs = _spoken_with(tmp_path, mesh_file, dict(OPEN_THEN_PUSH, lead_ms=50), "prepare_ms", (0, 250))
     lead, prepared = recs[0], recs[250]
     assert lead.prepare_ms == 50.0 and prepared.prepare_ms == 250.0  # never less than the lead
-    jaw = lambda rec: rec.control_points["jaw"][:, 1]  # noqa: E731
-    assert jaw(prepared)[0] < jaw(lead)[0] - 0.1  # the jaw 250 ms into its opening when the sound starts
-    at = lambda rec, x: rec.commanded_n[np.searchsorted(rec.time_s, x)]  # noqa: E731
+    # the jaw 250 ms into its opening when the sound starts
+    assert _jaw_height(prepared)[0] < _jaw_height(lead)[0] - 0.1
     # the second segment's forces still switch on 50 ms before its sound (0.10 s), in both (the first's JO
     # differs by its activation's last 0.03 %: 50 ms of rise against 300)
-    np.testing.assert_allclose(at(prepared, 0.09), at(lead, 0.09), atol=1e-3)
-    np.testing.assert_allclose(at(prepared, 0.11), at(lead, 0.11), atol=1e-3)
-    assert not np.allclose(at(lead, 0.09), at(lead, 0.11))
+    for t_s in (0.09, 0.11):
+        np.testing.assert_allclose(_commanded_at(prepared, t_s), _commanded_at(lead, t_s), atol=1e-3)
+    assert not np.allclose(_commanded_at(lead, 0.09), _commanded_at(lead, 0.11))
 
 
 def test_an_unreachable_target_exits_3_naming_its_segment_and_writes_nothing(tmp_path, mesh_file):
