@@ -104,6 +104,9 @@ class Simulation(Strict):
     record_every: Annotated[int, Field(ge=1)] = 1
     # left-right symmetry: the articulator's midsagittal tongue nodes keep z = 0 (no antisymmetric buckling)
     midsagittal_symmetry: bool = False
+    # the articulator's left half moves as the mirror image of its right half (exact under its symmetric loads):
+    # the Newton systems have the right half's unknowns only
+    mirror_symmetry: bool = False
 
 
 class StyloglossusFibre(Strict):

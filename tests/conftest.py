@@ -73,6 +73,15 @@ def art(cfg, mesh, wall):
 
 
 @pytest.fixture(scope="session")
+def art_half(cfg, mesh, wall):
+    """The articulator solved by halves: its left half moves as the mirror image of its right half."""
+    from artic_cli.mechanics.model import build_articulator
+
+    sim = cfg.simulation.model_copy(update={"mirror_symmetry": True})
+    return build_articulator(cfg.model_copy(update={"simulation": sim}), mesh, wall)
+
+
+@pytest.fixture(scope="session")
 def mesh_file(tmp_path_factory):
     out = tmp_path_factory.mktemp("mesh") / "mesh.h5"
     build_mesh(ROOT / "configs" / "default.yaml", out)

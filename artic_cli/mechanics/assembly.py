@@ -146,21 +146,35 @@ def _half_bandwidth(order: np.ndarray, pairs: np.ndarray, core_free: np.ndarray)
 
 
 def band_pattern(n_nodes: int, pairs: np.ndarray, fixed: np.ndarray, n_core: int | None = None,
-                 slaves: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None) -> BandPattern:
+                 slaves: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
+                 mirror: tuple[np.ndarray, np.ndarray] | None = None) -> BandPattern:
     """Pattern for a node graph with edges ``pairs`` and fixed dof mask (N,3).
 
     Nodes ``0 .. n_core-1`` form the banded core, in their given order or in
     reverse Cuthill-McKee order, whichever band is narrower; the other free
     nodes form the dense border.  ``slaves`` = (nodes (S,), masters (S,m),
     weights (S,m)): each slaved node moves as the weighted sum of its masters
-    (border nodes) and has no degrees of freedom of its own."""
+    (border nodes) and has no degrees of freedom of its own.  ``mirror`` =
+    (nodes (H,), images (H,)): each of ``nodes`` is the mirror image of its
+    image in the plane z = 0, (x, y, z) = (x', y', -z'), and has no degrees of
+    freedom either (one half of a left-right symmetric body is solved)."""
     n_core = n_nodes if n_core is None else n_core
     fixed = np.asarray(fixed, dtype=bool)
     slaved = np.zeros(n_nodes, dtype=bool)
     if slaves is not None:
         slaved[slaves[0]] = True
+    image = np.arange(n_nodes)  # the node whose dofs move each node (itself, or its mirror image)
+    if mirror is not None:
+        halves, images = (np.asarray(a, dtype=np.int64) for a in mirror)
+        if slaved[halves].any() or slaved[images].any() or np.isin(images, halves).any():
+            raise ValueError("a mirrored node is carried, or its image is mirrored itself")
+        if (fixed[halves] != fixed[images]).any():
+            raise ValueError("a mirrored node and its image are held differently")
+        image[halves] = images
+        slaved[halves] = True
     core = np.zeros(n_nodes, dtype=bool)
     core[:n_core] = ~slaved[:n_core]
+    pairs = image[pairs] if len(pairs) else pairs
     core_pairs = pairs[core[pairs].all(axis=1)] if len(pairs) else pairs
     adj = sp.coo_matrix((np.ones(len(core_pairs)), (core_pairs[:, 0], core_pairs[:, 1])), shape=(n_core, n_core))
     adj = (adj + adj.T + sp.eye(n_core)).tocsr()
@@ -174,18 +188,28 @@ def band_pattern(n_nodes: int, pairs: np.ndarray, fixed: np.ndarray, n_core: int
     dof_of[border] = n_core_free + np.arange(len(border))
     n_free = n_core_free + len(border)
     own = np.flatnonzero(dof_of >= 0)
-    rows, cols, vals = [own], [dof_of[own]], [np.ones(len(own))]
+    reduce = sp.csr_matrix((np.ones(len(own)), (own, dof_of[own])), shape=(3 * n_nodes, n_free))
+    if mirror is not None:  # a mirrored node's row: its image's, with z reversed
+        rows = (3 * halves[:, None] + np.arange(3)).ravel()
+        sign = sp.diags(np.tile([1.0, 1.0, -1.0], len(halves)))
+        pick = sp.csr_matrix((np.ones(len(rows)), (np.arange(len(rows)), (3 * images[:, None] + np.arange(3)).ravel())),
+                             shape=(len(rows), 3 * n_nodes))
+        reduce = reduce + sp.csr_matrix((np.ones(len(rows)), (rows, np.arange(len(rows)))),
+                                        shape=(3 * n_nodes, len(rows))) @ (sign @ pick @ reduce)
     if slaves is not None:
         nodes, masters, weights = (np.asarray(a) for a in slaves)
         for d in range(3):
-            m = dof_of[3 * masters + d]
-            if (m < 0).any():
+            if (dof_of[3 * image[masters] + d] < 0).any():
                 raise ValueError("a slaved node's master is fixed or slaved itself")
-            rows.append(np.repeat(3 * nodes + d, masters.shape[1]))
-            cols.append(m.ravel())
-            vals.append(weights.ravel())
-    reduce = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                           shape=(3 * n_nodes, n_free))
+        rows = (3 * nodes[:, None] + np.arange(3)).ravel()
+        cols = 3 * masters[:, None, :] + np.arange(3)[None, :, None]  # (S,3,m): dof d of each master
+        w = np.broadcast_to(weights[:, None, :], cols.shape)
+        spread = sp.csr_matrix((w.ravel(), (np.repeat(np.arange(len(rows)), masters.shape[1]), cols.ravel())),
+                               shape=(len(rows), 3 * n_nodes))
+        reduce = reduce + sp.csr_matrix((np.ones(len(rows)), (rows, np.arange(len(rows)))),
+                                        shape=(3 * n_nodes, len(rows))) @ (spread @ reduce)
+    reduce = reduce.tocsr()
+    reduce.eliminate_zeros()
     return BandPattern(n_free=n_free, n_core=n_core_free, u=u, dof_of=dof_of,
                        free_dofs=np.concatenate([free, border]), reduce=reduce)
 

@@ -26,6 +26,7 @@ from ..errors import ArticError
 from ..geometry.anatomy import JAW_MUSCLES, LINK_KINDS, TONGUE_MUSCLES, Body, build_body, check_muscle_names
 from ..geometry.hexahedra import corner_jacobians, volumes
 from ..geometry.mesh import Mesh
+from ..geometry.mirror import mirror_images
 from ..geometry.wall import WallSurface
 from .assembly import BandFactor, BandPattern, NodeAssembly, band_pattern, node_assembly
 from .calibration import calibrate
@@ -241,7 +242,8 @@ def _consistent_mass(i, j, m, n):
 
 
 def _finish(mesh: Mesh, rest: np.ndarray, cyl: CylinderSet, link_mass: np.ndarray, kappa: np.ndarray,
-            fixed: np.ndarray, sim: Simulation, gravity: float, n_core: int, bulk: float, **extra) -> Model:
+            fixed: np.ndarray, sim: Simulation, gravity: float, n_core: int, bulk: float,
+            mirror: tuple[np.ndarray, np.ndarray] | None = None, **extra) -> Model:
     n = len(rest)
     v0 = volumes(mesh.nodes, mesh.bricks)
     extra["corner_j0"] = corner_jacobians(mesh.nodes, mesh.bricks)
@@ -255,7 +257,7 @@ def _finish(mesh: Mesh, rest: np.ndarray, cyl: CylinderSet, link_mass: np.ndarra
         all_pairs = np.vstack([all_pairs, np.column_stack([ms.seg_i, ms.seg_j])])
     carried = extra.get("carried")
     slaves = None if carried is None else (carried.nodes, carried.masters, carried.weights)
-    pattern = band_pattern(n, all_pairs, fixed, n_core, slaves)
+    pattern = band_pattern(n, all_pairs, fixed, n_core, slaves, mirror)
     cyl_edges = np.column_stack([cyl.i, cyl.j])
     seg_edges = np.column_stack([ms.seg_i, ms.seg_j]) if ms is not None else np.zeros((0, 2), dtype=np.int64)
     asm = node_assembly(pattern, n, cyl_edges, mesh.bricks, seg_edges)
@@ -386,6 +388,13 @@ def build_articulator(cfg: Config, mesh: Mesh, wall: WallSurface | None = None, 
     fixed[body.fixed] = True
     if cfg.simulation.midsagittal_symmetry:  # the midsagittal nodes stay in their plane (carried ones follow the jaw)
         fixed[np.setdiff1d(mesh.node_sets["midsagittal"], body.carried), 2] = True
+    mirror = None
+    if cfg.simulation.mirror_symmetry:  # one half is solved, the other (z < 0) moves as its mirror image
+        image = mirror_images(body.nodes, body.names)
+        own = ~np.isin(np.arange(n), body.carried)
+        fixed[own & (image == np.arange(n)), 2] = True
+        halves = np.flatnonzero(own & (body.nodes[:, 2] < 0.0))
+        mirror = (halves, image[halves])
 
     mc = cfg.muscles
     names = list(TONGUE_MUSCLES + JAW_MUSCLES)
@@ -427,4 +436,4 @@ def build_articulator(cfg: Config, mesh: Mesh, wall: WallSurface | None = None, 
                    bulk_ratio * scale * e0,
                    node_sets=dict(body.node_sets), names=dict(body.names), muscles=ms,
                    groups={k: dict(v) for k, v in mc.groups.items()}, guide_spec=guide, contact=cm, wall=wall,
-                   tone=tone, carried=carried_points(body.nodes, body.carried, body.carrier))
+                   tone=tone, carried=carried_points(body.nodes, body.carried, body.carrier), mirror=mirror)

@@ -42,11 +42,14 @@ def test_compiled_kernels_give_the_numpy_numbers(art):
             assert np.allclose(a, c, rtol=1e-10, atol=1e-9 * np.abs(a).max())
 
 
-def test_node_level_assembly_is_t_transpose_k_t_of_the_element_blocks(art):
+@pytest.mark.parametrize("which", ["art", "art_half"])
+def test_node_level_assembly_is_t_transpose_k_t_of_the_element_blocks(which, request):
     """Random symmetric element blocks (cylinders and links, bricks, fibre segments) summed per node pair and
-    folded to flat storage give the stored parts of T^T K T, K assembled densely element by element."""
+    folded to flat storage give the stored parts of T^T K T, K assembled densely element by element; also when
+    the left half's nodes are folded onto their mirror images."""
     from artic_cli.mechanics.assembly import pair_blocks, sparse_blocks
 
+    art = request.getfixturevalue(which)
     rng = np.random.default_rng(11)
     n, asm, pat, ms = art.n_nodes, art.assembly, art.pattern, art.muscles
 
