@@ -72,13 +72,23 @@ def art(cfg, mesh, wall):
     return build_articulator(cfg, mesh, wall)
 
 
+def _articulator(cfg, mesh, wall, mirror: bool):
+    from artic_cli.mechanics.model import build_articulator
+
+    sim = cfg.simulation.model_copy(update={"mirror_symmetry": mirror})
+    return build_articulator(cfg.model_copy(update={"simulation": sim}), mesh, wall)
+
+
+@pytest.fixture(scope="session")
+def art_whole(cfg, mesh, wall):
+    """The articulator solved whole (``simulation.mirror_symmetry`` off)."""
+    return _articulator(cfg, mesh, wall, False)
+
+
 @pytest.fixture(scope="session")
 def art_half(cfg, mesh, wall):
     """The articulator solved by halves: its left half moves as the mirror image of its right half."""
-    from artic_cli.mechanics.model import build_articulator
-
-    sim = cfg.simulation.model_copy(update={"mirror_symmetry": True})
-    return build_articulator(cfg.model_copy(update={"simulation": sim}), mesh, wall)
+    return _articulator(cfg, mesh, wall, True)
 
 
 @pytest.fixture(scope="session")

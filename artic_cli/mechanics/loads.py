@@ -55,6 +55,13 @@ def muscle_shares(model: Model, name: str) -> np.ndarray:
     return share
 
 
+def check_symmetric(model: Model, f: np.ndarray, what: str) -> None:
+    """A model solved by halves takes only left-right symmetric node forces (``f`` (N,3), dyn)."""
+    if model.image is not None and not np.allclose(f[model.image] * [1.0, 1.0, -1.0], f, atol=1e-9 * np.abs(f).max()):
+        raise ArticError(f"{what} is not left-right symmetric, and the articulator is solved by halves; set "
+                         "simulation.mirror_symmetry: false in the config")
+
+
 def load_program(model: Model, schedule: Schedule, source: str = "schedule") -> LoadProgram:
     if schedule.muscles:
         if model.muscles is None:
@@ -65,6 +72,9 @@ def load_program(model: Model, schedule: Schedule, source: str = "schedule") -> 
         idx = model.node_set(e.nodes)
         nodes.append(idx)
         force.append(units.newton_to_dyn(np.asarray(e.force_n, dtype=float)) / len(idx))
+        f = np.zeros((model.n_nodes, 3))
+        f[idx] = force[-1]
+        check_symmetric(model, f, f"{source}: the load on '{e.nodes}'")
         on.append(units.ms_to_s(e.onset_ms))
         off.append(units.ms_to_s(e.onset_ms + e.duration_ms))
     m = len(model.muscle_names)
@@ -86,5 +96,6 @@ def control_from_newtons(model: Model, muscles_n: dict[str, float] | None = None
     for name, total in (loads_n or {}).items():
         idx = model.node_set(name)
         f[idx] += units.newton_to_dyn(np.asarray(total, dtype=float)) / len(idx)
+    check_symmetric(model, f, "a load")
     return Control(node_force=f, muscle_force=muscle_force_vector(model, muscles_n or {})
                    if model.muscles is not None else None)

@@ -124,6 +124,7 @@ class Model:
     corner_j0: np.ndarray | None = None  # (B,8) rest corner Jacobians (inversion guard)
     guard_weight: np.ndarray | None = None  # (B,) guard stiffness w = bulk x V0 / 8, erg
     carried: Carried | None = None  # points that move rigidly with the mandible
+    image: np.ndarray | None = None  # (N,) each node's mirror image, when the right half is solved for both
 
     @property
     def n_nodes(self) -> int:
@@ -436,4 +437,5 @@ def build_articulator(cfg: Config, mesh: Mesh, wall: WallSurface | None = None, 
                    bulk_ratio * scale * e0,
                    node_sets=dict(body.node_sets), names=dict(body.names), muscles=ms,
                    groups={k: dict(v) for k, v in mc.groups.items()}, guide_spec=guide, contact=cm, wall=wall,
-                   tone=tone, carried=carried_points(body.nodes, body.carried, body.carrier), mirror=mirror)
+                   tone=tone, carried=carried_points(body.nodes, body.carried, body.carrier), mirror=mirror,
+                   image=None if mirror is None else image)

@@ -42,7 +42,7 @@ def test_compiled_kernels_give_the_numpy_numbers(art):
             assert np.allclose(a, c, rtol=1e-10, atol=1e-9 * np.abs(a).max())
 
 
-@pytest.mark.parametrize("which", ["art", "art_half"])
+@pytest.mark.parametrize("which", ["art_whole", "art_half"])
 def test_node_level_assembly_is_t_transpose_k_t_of_the_element_blocks(which, request):
     """Random symmetric element blocks (cylinders and links, bricks, fibre segments) summed per node pair and
     folded to flat storage give the stored parts of T^T K T, K assembled densely element by element; also when

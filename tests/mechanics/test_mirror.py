@@ -8,8 +8,8 @@ from artic_cli.geometry.mirror import mirror_images
 
 
 @pytest.fixture(scope="module")
-def pair(art, art_half):
-    return art, art_half
+def pair(art_whole, art_half):
+    return art_whole, art_half
 
 
 def test_every_node_has_its_mirror_image(art):
@@ -62,3 +62,12 @@ def test_the_half_moves_as_the_whole_with_contact(pair):
     assert np.abs(whole[image] * [1.0, 1.0, -1.0] - whole).max() < 2e-3  # 0.0009 cm measured
     assert np.abs(half - whole).max() < 2e-3  # 0.0006 cm measured
     assert np.abs(whole - pair[0].rest).max() > 0.3  # it did move
+
+
+def test_a_sideways_load_on_a_halved_articulator_is_refused(art_half, art_whole):
+    from artic_cli.mechanics.loads import control_from_newtons
+
+    with pytest.raises(ArticError, match="not left-right symmetric.*mirror_symmetry: false"):
+        control_from_newtons(art_half, {"SL": 4.0}, loads_n={"tip": (0.0, 0.0, 0.2)})
+    control_from_newtons(art_half, {"SL": 4.0}, loads_n={"tip": (0.1, -0.2, 0.0)})  # in the plane: symmetric
+    control_from_newtons(art_whole, {"SL": 4.0}, loads_n={"tip": (0.0, 0.0, 0.2)})
