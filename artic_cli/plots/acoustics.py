@@ -7,6 +7,7 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
+from ..acoustics.spectrogram import spectrogram
 from .common import save_figure
 
 CLOSURE_CM2 = 0.05  # frames narrower than this are shaded: the tract is (nearly) closed
@@ -52,11 +53,8 @@ def plot_tracks(result, path: Path | str, title: str = "") -> Path:
 def plot_spectrogram(samples: np.ndarray, sample_rate_hz: int, path: Path | str, title: str = "",
                      max_hz: float = 5500.0) -> Path:
     """A wide-band spectrogram (6-ms Hann windows), 60 dB of range."""
-    from scipy.signal import spectrogram
-
     nper = max(16, int(0.006 * sample_rate_hz))
-    f, t, sxx = spectrogram(samples, fs=sample_rate_hz, window="hann", nperseg=nper, noverlap=nper * 3 // 4,
-                            nfft=max(512, nper))
+    f, t, sxx = spectrogram(samples, sample_rate_hz, nper, nper * 3 // 4, max(512, nper))
     db = 10 * np.log10(np.maximum(sxx, 1e-20))
     keep = f <= max_hz
     fig, ax = plt.subplots(figsize=(8, 4))

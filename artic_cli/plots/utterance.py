@@ -8,16 +8,14 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
+from ..acoustics.spectrogram import spectrogram
 from .common import save_figure
 
 
 def plot_utterance(record, samples: np.ndarray, sample_rate_hz: int, path: Path | str, max_hz: float = 8000.0) -> Path:
     """``record``: :class:`artic_cli.stages.speak.Record`; ``samples``: its WAV."""
-    from scipy.signal import spectrogram
-
     nper = max(16, int(0.006 * sample_rate_hz))
-    f, t, sxx = spectrogram(samples, fs=sample_rate_hz, window="hann", nperseg=nper, noverlap=nper * 3 // 4,
-                            nfft=max(512, nper))
+    f, t, sxx = spectrogram(samples, sample_rate_hz, nper, nper * 3 // 4, max(512, nper))
     db = 10 * np.log10(np.maximum(sxx, 1e-20))
     keep = f <= max_hz
     fig, (ax, bx) = plt.subplots(2, 1, figsize=(9, 6.5), sharex=True, gridspec_kw={"height_ratios": [3, 2]})

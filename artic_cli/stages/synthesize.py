@@ -11,8 +11,9 @@ import numpy as np
 from pydantic import Field
 from scipy.io import wavfile
 
-from ..acoustics.source import lf_flow_derivative
 from ..acoustics.model import tract_of
+from ..acoustics.resample import half_rate
+from ..acoustics.source import lf_flow_derivative
 from ..acoustics.synthesis import noise_samples, resample_tube, sections_for, side_branch, synthesize
 from ..acoustics.tube import Tube, read_tube_csv
 from ..config import Config, load_config
@@ -99,9 +100,7 @@ def compute_frames(lengths_cm: np.ndarray, areas_cm2: np.ndarray, times_s: np.nd
                    sy.section_loss, ac.air_density_g_cm3, ac.sound_speed_cm_s, branch, flow_peak_cm3_s, pn,
                    (ac.wall_mass_g_cm2, ac.wall_resistance_dyn_s_cm3, ac.wall_stiffness_dyn_cm3)
                    if ac.yielding_walls else None)
-    from scipy.signal import resample_poly  # here: importing scipy.signal takes 2.6 s, only a voice needs it
-
-    y = resample_poly(y, 1, 2)
+    y = half_rate(y)
     peak = float(np.max(np.abs(y))) if len(y) else 0.0
     return Audio(0.9 * y / peak if peak > 0 else y, sy.sample_rate_hz)
 
