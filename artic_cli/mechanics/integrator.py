@@ -337,6 +337,10 @@ def _step_once(model: Model, state: State, control: Control, h: float) -> State:
         _, active, mag = contact_forces(model, x, planes)
         contact_nodes, contact_force = planes.nodes[active], mag[active]
         x, v_new, projected, query = enforce(model.contact, x, v_new)
+        # a mirrored node has no dofs: a projection of its own (the wall's triangles are not mirror images) would
+        # stay with it for good
+        model.mirror(x)
+        model.mirror(v_new)
         if query is not None:
             wall_cache = (x, query)
     sigma2, strain = state.sigma2, state.fibre_strain

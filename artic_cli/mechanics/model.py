@@ -95,6 +95,9 @@ def carried_points(rest: np.ndarray, nodes: np.ndarray, frame: np.ndarray) -> Ca
     return Carried(nodes=np.asarray(nodes), masters=np.broadcast_to(frame, (len(nodes), 4)).copy(), weights=w)
 
 
+_MIRROR = np.array([1.0, 1.0, -1.0])  # the reflection in the midsagittal plane z = 0
+
+
 @dataclass(frozen=True)
 class Model:
     mesh: Mesh
@@ -125,6 +128,13 @@ class Model:
     guard_weight: np.ndarray | None = None  # (B,) guard stiffness w = bulk x V0 / 8, erg
     carried: Carried | None = None  # points that move rigidly with the mandible
     image: np.ndarray | None = None  # (N,) each node's mirror image, when the right half is solved for both
+    mirrored: np.ndarray | None = None  # (H,) the nodes that move as their image's mirror (no dofs of their own)
+
+    def mirror(self, x: np.ndarray) -> np.ndarray:
+        """``x`` (N,3) with each mirrored node put at its image's mirror place (in place, returned)."""
+        if self.mirrored is not None:
+            x[self.mirrored] = x[self.image[self.mirrored]] * _MIRROR
+        return x
 
     @property
     def n_nodes(self) -> int:
@@ -438,4 +448,4 @@ def build_articulator(cfg: Config, mesh: Mesh, wall: WallSurface | None = None, 
                    node_sets=dict(body.node_sets), names=dict(body.names), muscles=ms,
                    groups={k: dict(v) for k, v in mc.groups.items()}, guide_spec=guide, contact=cm, wall=wall,
                    tone=tone, carried=carried_points(body.nodes, body.carried, body.carrier), mirror=mirror,
-                   image=None if mirror is None else image)
+                   image=None if mirror is None else image, mirrored=None if mirror is None else halves)
