@@ -12,6 +12,12 @@ REPORT   ?= $(if $(filter data,$(OUT)),reports,$(OUT)/reports)
 PIPELINE ?= pipelines/paper.yaml
 FIG9_JAW ?= JO_2.5
 
+# one BLAS/OpenMP thread per process: the systems are small, parallelism comes from processes, and a spare
+# BLAS thread spinning beside a parallel stage's workers eats half a core
+export OPENBLAS_NUM_THREADS ?= 1
+export OMP_NUM_THREADS ?= 1
+export MKL_NUM_THREADS ?= 1
+
 PY     := $(VENV)/bin/python
 ARTIC  := $(VENV)/bin/artic
 SRC    := $(shell find artic_cli -name '*.py')
@@ -57,4 +63,5 @@ bench: setup $(OUT)/epmaps.h5 $(OUT)/dynamic.h5
 
 clean:
 	rm -rf $(OUT)/*.h5 $(OUT)/*.json $(OUT)/sims $(OUT)/experiments $(OUT)/solutions $(OUT)/cache $(OUT)/.stamps \
+	  $(OUT)/tracts $(OUT)/acoustics $(OUT)/audio $(OUT)/vowels $(OUT)/utterances \
 	  $(OUT)/.config $(PIPELINE_MK) $(REPORT)/*.png $(REPORT)/*.gif $(REPORT)/paper.md
