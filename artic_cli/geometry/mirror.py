@@ -6,6 +6,7 @@ import numpy as np
 
 from ..errors import ArticError
 
+MIRROR = np.array([1.0, 1.0, -1.0])  # the reflection in the midsagittal plane z = 0, per coordinate
 _DIGITS = 9  # coordinates agreeing to 1e-9 cm are the same point
 
 
@@ -25,8 +26,8 @@ def mirror_images(nodes: np.ndarray, names: dict[str, int]) -> np.ndarray:
         named[i] = True
     where = {tuple(p): i for i, p in enumerate(np.round(nodes, _DIGITS).tolist()) if not named[i]}
     for i in np.flatnonzero(~named):
-        image[i] = where.get(tuple(np.round(nodes[i] * [1.0, 1.0, -1.0], _DIGITS) + 0.0), -1)
-    bad = np.flatnonzero((image < 0) | (np.abs(nodes[image] * [1.0, 1.0, -1.0] - nodes).max(axis=1) > 1e-6))
+        image[i] = where.get(tuple(np.round(nodes[i] * MIRROR, _DIGITS)), -1)
+    bad = np.flatnonzero((image < 0) | (np.abs(nodes[image] * MIRROR - nodes).max(axis=1) > 1e-6))
     if len(bad):
         raise ArticError(f"the body is not left-right symmetric: node {bad[0]} at {np.round(nodes[bad[0]], 3).tolist()} "
                          "cm has no mirror image; set simulation.mirror_symmetry: false")

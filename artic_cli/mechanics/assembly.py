@@ -26,6 +26,8 @@ import scipy.sparse as sp
 from scipy.linalg.lapack import dpbtrf, dpotrf, dpotrs, dtbtrs, dtrtrs
 from scipy.sparse.csgraph import reverse_cuthill_mckee
 
+from ..geometry.mirror import MIRROR
+
 
 @dataclass(frozen=True)
 class BandPattern:
@@ -190,28 +192,29 @@ def band_pattern(n_nodes: int, pairs: np.ndarray, fixed: np.ndarray, n_core: int
     own = np.flatnonzero(dof_of >= 0)
     reduce = sp.csr_matrix((np.ones(len(own)), (own, dof_of[own])), shape=(3 * n_nodes, n_free))
     if mirror is not None:  # a mirrored node's row: its image's, with z reversed
-        rows = (3 * halves[:, None] + np.arange(3)).ravel()
-        sign = sp.diags(np.tile([1.0, 1.0, -1.0], len(halves)))
-        pick = sp.csr_matrix((np.ones(len(rows)), (np.arange(len(rows)), (3 * images[:, None] + np.arange(3)).ravel())),
-                             shape=(len(rows), 3 * n_nodes))
-        reduce = reduce + sp.csr_matrix((np.ones(len(rows)), (rows, np.arange(len(rows)))),
-                                        shape=(3 * n_nodes, len(rows))) @ (sign @ pick @ reduce)
+        dofs = (3 * images[:, None] + np.arange(3)).ravel()
+        flip = sp.csr_matrix((np.tile(MIRROR, len(halves)), (np.arange(len(dofs)), dofs)), shape=(len(dofs), 3 * n_nodes))
+        reduce = reduce + _onto_rows((3 * halves[:, None] + np.arange(3)).ravel(), flip @ reduce, 3 * n_nodes)
     if slaves is not None:
         nodes, masters, weights = (np.asarray(a) for a in slaves)
         for d in range(3):
             if (dof_of[3 * image[masters] + d] < 0).any():
                 raise ValueError("a slaved node's master is fixed or slaved itself")
-        rows = (3 * nodes[:, None] + np.arange(3)).ravel()
         cols = 3 * masters[:, None, :] + np.arange(3)[None, :, None]  # (S,3,m): dof d of each master
         w = np.broadcast_to(weights[:, None, :], cols.shape)
-        spread = sp.csr_matrix((w.ravel(), (np.repeat(np.arange(len(rows)), masters.shape[1]), cols.ravel())),
-                               shape=(len(rows), 3 * n_nodes))
-        reduce = reduce + sp.csr_matrix((np.ones(len(rows)), (rows, np.arange(len(rows)))),
-                                        shape=(3 * n_nodes, len(rows))) @ (spread @ reduce)
+        spread = sp.csr_matrix((w.ravel(), (np.repeat(np.arange(3 * len(nodes)), masters.shape[1]), cols.ravel())),
+                               shape=(3 * len(nodes), 3 * n_nodes))
+        reduce = reduce + _onto_rows((3 * nodes[:, None] + np.arange(3)).ravel(), spread @ reduce, 3 * n_nodes)
     reduce = reduce.tocsr()
     reduce.eliminate_zeros()
     return BandPattern(n_free=n_free, n_core=n_core_free, u=u, dof_of=dof_of,
                        free_dofs=np.concatenate([free, border]), reduce=reduce)
+
+
+def _onto_rows(rows: np.ndarray, block: sp.spmatrix, n_dofs: int) -> sp.csr_matrix:
+    """(n_dofs, block's columns): ``block``'s k-th row placed at row ``rows[k]``, zero elsewhere."""
+    place = sp.csr_matrix((np.ones(len(rows)), (rows, np.arange(len(rows)))), shape=(n_dofs, len(rows)))
+    return place @ block
 
 
 def _check(info: int, what: str) -> None:

@@ -8,6 +8,7 @@ import numpy as np
 
 from .. import units
 from ..errors import ArticError
+from ..geometry.mirror import MIRROR
 from ..schedule import Schedule
 from .model import Control, Model
 
@@ -57,7 +58,7 @@ def muscle_shares(model: Model, name: str) -> np.ndarray:
 
 def check_symmetric(model: Model, f: np.ndarray, what: str) -> None:
     """A model solved by halves takes only left-right symmetric node forces (``f`` (N,3), dyn)."""
-    if model.image is not None and not np.allclose(f[model.image] * [1.0, 1.0, -1.0], f, atol=1e-9 * np.abs(f).max()):
+    if model.image is not None and not np.allclose(f[model.image] * MIRROR, f, atol=1e-9 * np.abs(f).max()):
         raise ArticError(f"{what} is not left-right symmetric, and the articulator is solved by halves; set "
                          "simulation.mirror_symmetry: false in the config")
 

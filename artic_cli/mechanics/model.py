@@ -26,7 +26,7 @@ from ..errors import ArticError
 from ..geometry.anatomy import JAW_MUSCLES, LINK_KINDS, TONGUE_MUSCLES, Body, build_body, check_muscle_names
 from ..geometry.hexahedra import corner_jacobians, volumes
 from ..geometry.mesh import Mesh
-from ..geometry.mirror import mirror_images
+from ..geometry.mirror import MIRROR, mirror_images
 from ..geometry.wall import WallSurface
 from .assembly import BandFactor, BandPattern, NodeAssembly, band_pattern, node_assembly
 from .calibration import calibrate
@@ -95,9 +95,6 @@ def carried_points(rest: np.ndarray, nodes: np.ndarray, frame: np.ndarray) -> Ca
     return Carried(nodes=np.asarray(nodes), masters=np.broadcast_to(frame, (len(nodes), 4)).copy(), weights=w)
 
 
-_MIRROR = np.array([1.0, 1.0, -1.0])  # the reflection in the midsagittal plane z = 0
-
-
 @dataclass(frozen=True)
 class Model:
     mesh: Mesh
@@ -133,7 +130,7 @@ class Model:
     def mirror(self, x: np.ndarray) -> np.ndarray:
         """``x`` (N,3) with each mirrored node put at its image's mirror place (in place, returned)."""
         if self.mirrored is not None:
-            x[self.mirrored] = x[self.image[self.mirrored]] * _MIRROR
+            x[self.mirrored] = x[self.image[self.mirrored]] * MIRROR
         return x
 
     @property
