@@ -11,6 +11,12 @@ override OUT := $(patsubst %/,%,$(OUT))
 REPORT   ?= $(if $(filter data,$(OUT)),reports,$(OUT)/reports)
 PIPELINE ?= pipelines/paper.yaml
 FIG9_JAW ?= JO_2.5
+# `make paper` runs JOBS stages at a time (JOBS=1: one after another); the muscle-function study, which keeps
+# both cores busy by itself, runs last, alone (the stage table's `last`)
+JOBS     ?= 2
+ifneq ($(filter paper,$(MAKECMDGOALS)),)
+MAKEFLAGS += -j$(JOBS)
+endif
 
 # one BLAS/OpenMP thread per process: the systems are small, parallelism comes from processes, and a spare
 # BLAS thread spinning beside a parallel stage's workers eats half a core

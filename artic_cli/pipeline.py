@@ -94,6 +94,7 @@ def render(p: Pipeline) -> str:
     artefacts: list[str] = []
     figures: list[str] = []
     targets: dict[str, list[str]] = {}
+    last: list[tuple[str, list[str]]] = []  # stamps of the `last` stages, and their outputs and figures
     for st in STAGES:
         module = importlib.import_module(st.module)
         sections = [f"$(OUT)/.config/{s}.json" for s in module.STAGE.sections]
@@ -114,6 +115,8 @@ def render(p: Pipeline) -> str:
                       f"{output}: {stamp} ; @test -f $@ || {{ rm -f $<; $(MAKE) --no-print-directory $< OUT=$(OUT) "
                       "CONFIG=$(CONFIG) REPORT=$(REPORT); }", ""]
             outs.append(output)
+            if st.last:
+                last.append((stamp, [output]))
             groups: dict[str, list] = {}  # one rule (grouped targets) per plotting command
             for fig in st.figures:
                 if not fig.items or name in getattr(p, fig.items, [fig.items]):
@@ -126,9 +129,16 @@ def render(p: Pipeline) -> str:
                 lines += [f"{' '.join(paths)} &: {output} {' '.join(deps)} | setup",
                           f"\t$(ARTIC) {_fill(command, **kw)} {options}", ""]
                 figures += paths
+                if st.last:
+                    last[-1][1].extend(paths)
         artefacts += outs
         targets.setdefault(st.name.split("-")[0], []).extend(outs)
     report = _fill(REPORT_OUTPUT)
+    if last:  # under `make -j paper` a `last` stage waits (order only) for everything that does not need it
+        after = [x for x in artefacts + figures if not any(x in own for _, own in last)]
+        lines += ["ifneq ($(filter paper,$(MAKECMDGOALS)),)"]
+        lines += [f"{stamp}: | {' '.join(after)}" for stamp, _ in last]
+        lines += ["endif", ""]
     lines += [f"{report}: {' '.join(artefacts)} {' '.join(figures)} {' '.join(_files(REPORT_MODULE))} | setup",
               "\t$(ARTIC) report --data $(OUT) --out $@", ""]
     for name, outs in targets.items():

@@ -14,9 +14,16 @@ R = 128 rho c / (9 pi^2 A), L = 8 rho / (3 pi sqrt(pi A)).
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 
 import numpy as np
+
+# The frequency loop runs on numba's OpenMP threads.  OpenMP's threads spin while they wait by default: beside
+# another busy process (make -j2, pytest -n 2) a loop's threads then wait for each other's time slices, and the
+# acoustic map took 85 s instead of 40 s beside one busy core (27 s alone either way).  Read when OpenMP
+# loads, at the first parallel loop.
+os.environ.setdefault("OMP_WAIT_POLICY", "passive")
 
 from ..mechanics.kernels import AVAILABLE, njit
 

@@ -32,6 +32,9 @@ class StageEntry:
     items: str = ""  # pipeline list the stage runs once per item of
     ok_status: tuple[int, ...] = (0,)  # exit statuses that still count as done (3: target unreachable, answer written)
     figures: tuple[Figure, ...] = field(default_factory=tuple)
+    # `make paper` runs it after every other stage and figure: it keeps both cores busy by itself, and beside
+    # other stages each slows the other more than their sum
+    last: bool = False
 
 
 MESH = "{out}/mesh.h5"
@@ -41,10 +44,51 @@ DYN = "{out}/dynamic.h5"
 SIM_PLOT = "plot simulation {output} --mesh {mesh} --config {config}"
 MF_PLOT = "plot muscle-function {output}"
 
+# in the order `make -j` should start them: the EP maps' chain (maps, acoustic maps, vowels, utterances) is the
+# longest path
 STAGES: tuple[StageEntry, ...] = (
     StageEntry("mesh", "artic_cli.stages.mesh", MESH, "build-mesh --config {config} --out {output}",
                figures=(Figure("{report}/fig1_mesh.png", "plot mesh --mesh {output} --config {config}", "--out {figure}",
                                "artic_cli.plots.mesh", ("{out}/.config/vocal_tract.json",)),)),
+    StageEntry("epmaps", "artic_cli.stages.epmap", MAPS,
+               "ep-map --mesh {mesh} --config {config} --out {output} --jobs 2 --cache {out}/cache", inputs=(MESH,),
+               figures=(Figure("{report}/fig8_epmap.png", "plot ep-map --maps {output}", "--out {figure}",
+                               "artic_cli.plots.epmap"),)),
+    StageEntry("dynamic", "artic_cli.stages.dynamic", DYN, "dynamic-map --maps {maps} --out {output}",
+               inputs=(MAPS,),
+               figures=(Figure("{report}/fig9_dynamic_map.png", "plot dynamic-map --maps {maps} --dynamic {output} "
+                               "--jaw $(FIG9_JAW)", "--out {figure}", "artic_cli.plots.dynamic", (MAPS,)),)),
+    StageEntry("acousticmaps", "artic_cli.stages.acoustic_map", "{out}/acoustic_maps.h5",
+               "acoustic-map --maps {maps} --mesh {mesh} --config {config} --out {output}", inputs=(MAPS, MESH),
+               figures=(Figure("{report}/vowel_space.png", "plot acoustic-map {output}", "--out {figure}",
+                               "artic_cli.plots.acoustic_map"),)),
+    StageEntry("vowels", "artic_cli.stages.solve", "{out}/vowels/{name}.yaml",
+               "solve-target configs/targets/vowels/{name}.yaml --maps {maps} --mesh {mesh} --config {config} "
+               "--acoustic-maps {out}/acoustic_maps.h5 --refine --out {output}",
+               inputs=(MAPS, MESH, "{out}/acoustic_maps.h5", "configs/targets/vowels/{name}.yaml"), items="vowels",
+               ok_status=(0, 3),
+               figures=(Figure("{report}/vowel_{name}.png", "plot solution {output} --target "
+                               "configs/targets/vowels/{name}.yaml", "--out {figure}", "artic_cli.plots.solution",
+                               ("configs/targets/vowels/{name}.yaml",)),)),
+    StageEntry("utterances", "artic_cli.stages.speak", "{out}/utterances/{name}.h5",
+               "speak configs/utterances/{name}.yaml --maps {maps} --mesh {mesh} --config {config} "
+               "--acoustic-maps {out}/acoustic_maps.h5 --accept-nearest --out {out}/utterances/{name}.wav",
+               inputs=(MAPS, MESH, "{out}/acoustic_maps.h5", "configs/utterances/{name}.yaml",
+                       "$(wildcard configs/targets/vowels/*.yaml configs/targets/consonants/*.yaml)"),
+               items="utterances",
+               figures=(Figure("{report}/utterance_{name}.png", "plot utterance {output}", "--out {figure}",
+                               "artic_cli.plots.utterance"),)),
+    StageEntry("vowels-audio", "artic_cli.stages.synthesize", "{out}/vowels/{name}.wav",
+               "synthesize --solution {out}/vowels/{name}.yaml --duration 0.6 --f0-contour "
+               "configs/voice/f0_fall_125_100.csv --config {config} --out {output}",
+               inputs=("{out}/vowels/{name}.yaml", "configs/voice/f0_fall_125_100.csv"), items="vowels"),
+    StageEntry("solve", "artic_cli.stages.solve", "{out}/solutions/{name}.yaml",
+               "solve-target {target} --maps {maps} --dynamic {dynamic} --mesh {mesh} --config {config} --verify "
+               "--refine --out {output}", inputs=(MAPS, DYN, MESH, "configs/targets/{name}.yaml"), items="targets",
+               ok_status=(0, 3),
+               figures=(Figure("{report}/fig12_{name}.png", "plot solution {output} --target {target} --maps {maps} "
+                               "--dynamic {dynamic}", "--out {figure}", "artic_cli.plots.solution",
+                               (MAPS, DYN, "configs/targets/{name}.yaml")),)),
     StageEntry("cuboid", "artic_cli.stages.cuboid", "{out}/cuboid.json",
                "validate cuboid --config {config} --out {output}"),
     StageEntry("sims-tissue", "artic_cli.stages.simulate", "{out}/sims/{name}.h5",
@@ -94,50 +138,11 @@ STAGES: tuple[StageEntry, ...] = (
                                "artic_cli.plots.muscle_function", items="fig7"),)),
     StageEntry("musclefunction", "artic_cli.stages.muscle_function", "{out}/muscle_function.h5",
                "muscle-function --mesh {mesh} --config {config} --out {output} --jobs 2 --cache {out}/cache",
-               inputs=(MESH,),
+               inputs=(MESH,), last=True,
                figures=(Figure("{report}/fig5_muscle_function_tip.png", MF_PLOT, "--tip {figure}",
                                "artic_cli.plots.muscle_function"),
                         Figure("{report}/fig6_muscle_function_dorsum.png", MF_PLOT, "--dorsum {figure}",
                                "artic_cli.plots.muscle_function"))),
-    StageEntry("epmaps", "artic_cli.stages.epmap", MAPS,
-               "ep-map --mesh {mesh} --config {config} --out {output} --jobs 2 --cache {out}/cache", inputs=(MESH,),
-               figures=(Figure("{report}/fig8_epmap.png", "plot ep-map --maps {output}", "--out {figure}",
-                               "artic_cli.plots.epmap"),)),
-    StageEntry("acousticmaps", "artic_cli.stages.acoustic_map", "{out}/acoustic_maps.h5",
-               "acoustic-map --maps {maps} --mesh {mesh} --config {config} --out {output}", inputs=(MAPS, MESH),
-               figures=(Figure("{report}/vowel_space.png", "plot acoustic-map {output}", "--out {figure}",
-                               "artic_cli.plots.acoustic_map"),)),
-    StageEntry("dynamic", "artic_cli.stages.dynamic", DYN, "dynamic-map --maps {maps} --out {output}",
-               inputs=(MAPS,),
-               figures=(Figure("{report}/fig9_dynamic_map.png", "plot dynamic-map --maps {maps} --dynamic {output} "
-                               "--jaw $(FIG9_JAW)", "--out {figure}", "artic_cli.plots.dynamic", (MAPS,)),)),
-    StageEntry("solve", "artic_cli.stages.solve", "{out}/solutions/{name}.yaml",
-               "solve-target {target} --maps {maps} --dynamic {dynamic} --mesh {mesh} --config {config} --verify "
-               "--refine --out {output}", inputs=(MAPS, DYN, MESH, "configs/targets/{name}.yaml"), items="targets",
-               ok_status=(0, 3),
-               figures=(Figure("{report}/fig12_{name}.png", "plot solution {output} --target {target} --maps {maps} "
-                               "--dynamic {dynamic}", "--out {figure}", "artic_cli.plots.solution",
-                               (MAPS, DYN, "configs/targets/{name}.yaml")),)),
-    StageEntry("vowels", "artic_cli.stages.solve", "{out}/vowels/{name}.yaml",
-               "solve-target configs/targets/vowels/{name}.yaml --maps {maps} --mesh {mesh} --config {config} "
-               "--acoustic-maps {out}/acoustic_maps.h5 --refine --out {output}",
-               inputs=(MAPS, MESH, "{out}/acoustic_maps.h5", "configs/targets/vowels/{name}.yaml"), items="vowels",
-               ok_status=(0, 3),
-               figures=(Figure("{report}/vowel_{name}.png", "plot solution {output} --target "
-                               "configs/targets/vowels/{name}.yaml", "--out {figure}", "artic_cli.plots.solution",
-                               ("configs/targets/vowels/{name}.yaml",)),)),
-    StageEntry("vowels-audio", "artic_cli.stages.synthesize", "{out}/vowels/{name}.wav",
-               "synthesize --solution {out}/vowels/{name}.yaml --duration 0.6 --f0-contour "
-               "configs/voice/f0_fall_125_100.csv --config {config} --out {output}",
-               inputs=("{out}/vowels/{name}.yaml", "configs/voice/f0_fall_125_100.csv"), items="vowels"),
-    StageEntry("utterances", "artic_cli.stages.speak", "{out}/utterances/{name}.h5",
-               "speak configs/utterances/{name}.yaml --maps {maps} --mesh {mesh} --config {config} "
-               "--acoustic-maps {out}/acoustic_maps.h5 --accept-nearest --out {out}/utterances/{name}.wav",
-               inputs=(MAPS, MESH, "{out}/acoustic_maps.h5", "configs/utterances/{name}.yaml",
-                       "$(wildcard configs/targets/vowels/*.yaml configs/targets/consonants/*.yaml)"),
-               items="utterances",
-               figures=(Figure("{report}/utterance_{name}.png", "plot utterance {output}", "--out {figure}",
-                               "artic_cli.plots.utterance"),)),
 )
 
 
