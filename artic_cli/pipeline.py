@@ -94,7 +94,9 @@ def render(p: Pipeline) -> str:
     artefacts: list[str] = []
     figures: list[str] = []
     targets: dict[str, list[str]] = {}
-    last: list[tuple[str, list[str]]] = []  # stamps of the `last` stages, and their outputs and figures
+    stamps: dict[str, str] = {}  # output -> its stamp
+    reads: dict[str, list[str]] = {}  # output -> what its stage reads
+    alone: dict[str, list[tuple[str, list[str]]]] = {"first": [], "last": []}  # (stamp, its outputs and figures)
     for st in STAGES:
         module = importlib.import_module(st.module)
         sections = [f"$(OUT)/.config/{s}.json" for s in module.STAGE.sections]
@@ -115,8 +117,9 @@ def render(p: Pipeline) -> str:
                       f"{output}: {stamp} ; @test -f $@ || {{ rm -f $<; $(MAKE) --no-print-directory $< OUT=$(OUT) "
                       "CONFIG=$(CONFIG) REPORT=$(REPORT); }", ""]
             outs.append(output)
-            if st.last:
-                last.append((stamp, [output]))
+            stamps[output], reads[output] = stamp, inputs.split()
+            if st.alone:
+                alone[st.alone].append((stamp, [output]))
             groups: dict[str, list] = {}  # one rule (grouped targets) per plotting command
             for fig in st.figures:
                 if not fig.items or name in getattr(p, fig.items, [fig.items]):
@@ -129,16 +132,12 @@ def render(p: Pipeline) -> str:
                 lines += [f"{' '.join(paths)} &: {output} {' '.join(deps)} | setup",
                           f"\t$(ARTIC) {_fill(command, **kw)} {options}", ""]
                 figures += paths
-                if st.last:
-                    last[-1][1].extend(paths)
+                if st.alone:
+                    alone[st.alone][-1][1].extend(paths)
         artefacts += outs
         targets.setdefault(st.name.split("-")[0], []).extend(outs)
     report = _fill(REPORT_OUTPUT)
-    if last:  # under `make -j paper` a `last` stage waits (order only) for everything that does not need it
-        after = [x for x in artefacts + figures if not any(x in own for _, own in last)]
-        lines += ["ifneq ($(filter paper,$(MAKECMDGOALS)),)"]
-        lines += [f"{stamp}: | {' '.join(after)}" for stamp, _ in last]
-        lines += ["endif", ""]
+    lines += _alone_rules(alone, stamps, reads, artefacts + figures)
     lines += [f"{report}: {' '.join(artefacts)} {' '.join(figures)} {' '.join(_files(REPORT_MODULE))} | setup",
               "\t$(ARTIC) report --data $(OUT) --out $@", ""]
     for name, outs in targets.items():
@@ -146,6 +145,26 @@ def render(p: Pipeline) -> str:
     lines += [f"figures: {' '.join(figures)}", f"paper: {report}",
               f".PHONY: {' '.join(targets)} figures paper", ""]
     return "\n".join(lines)
+
+
+def _alone_rules(alone: dict, stamps: dict, reads: dict, made: list[str]) -> list[str]:
+    """Order-only prerequisites, under `make -j paper` only, that run a stage alone: a ``first`` one before
+    every stage that does not feed it, a ``last`` one after everything that does not need it."""
+    if len(alone["first"]) > 1:
+        raise ArticError("the stage table marks more than one stage alone='first'; they would wait for each other")
+    lines = []
+    for stamp, own in alone["first"]:
+        upstream, todo = set(), [i for o in own if o in reads for i in reads[o]]
+        while todo:
+            x = todo.pop()
+            if x in reads and x not in upstream:
+                upstream.add(x)
+                todo += reads[x]
+        lines += [f"{s}: | {own[0]}" for o, s in stamps.items() if o not in upstream and o not in own]
+    for stamp, own in alone["last"]:
+        lasts = {x for _, o in alone["last"] for x in o}
+        lines.append(f"{stamp}: | {' '.join(x for x in made if x not in lasts)}")
+    return ["ifneq ($(filter paper,$(MAKECMDGOALS)),)", *lines, "endif", ""] if lines else []
 
 
 def split_sections(config: Path | str, folder: Path | str) -> list[str]:

@@ -27,7 +27,7 @@ from .assembly import add_low_rank, factorize
 from .contact import ContactPlanes, contact_planes, enforce
 from .model import Control, Model, State
 from .penalty import ramp
-from .muscles import FibreState, fibre_state, fibre_stiffness, length_gradients, muscle_forces
+from .muscles import FibreState, fibre_state, fibre_stiffness as _fibre_stiffness, length_gradients, muscle_forces
 from ..geometry.hexahedra import SHAPE_GRADIENTS_CORNER, SHAPE_GRADIENTS_GAUSS
 from .volume import GUARD_FRACTION, corner_guard, volume_forces
 
@@ -67,6 +67,13 @@ def internal_forces(model: Model, x: np.ndarray, v: np.ndarray | None = None,
         fg, guard = corner_guard(x[:nt], model.bricks, model.corner_j0, model.guard_weight)
         f[:nt] += fg
     return f, cs, vol, grad, guard
+
+
+def fibre_stiffness(model: Model, fs: FibreState, act: np.ndarray, h: float) -> np.ndarray:
+    """(F,) the fibres' stiffness along their length (:func:`.muscles.fibre_stiffness`); a mirrored model's
+    twins get their mean, so that both fall on the same side of the rank-one threshold."""
+    kf = _fibre_stiffness(model.muscles, fs, act, h)
+    return kf if model.fibre_twin is None else 0.5 * (kf + kf[model.fibre_twin])
 
 
 def guide_forces(model: Model, x: np.ndarray) -> np.ndarray:
@@ -129,7 +136,7 @@ def tangent(model: Model, cs: elements.CylinderState, frame: elements.DampingFra
     if fs is not None:
         t = np.maximum(fs.tension[ms.seg_fibre], 0.0) / fs.seg_length
         nn = fs.n[:, :, None] * fs.n[:, None, :]
-        kf = fibre_stiffness(ms, fs, act, h)
+        kf = fibre_stiffness(model, fs, act, h)
         soft = np.where(kf < _RANK_ONE_STIFFNESS, kf * ms.fibre_l0, 0.0)  # split in series
         k_seg = t[:, None, None] * (_EYE - nn) + (soft[ms.seg_fibre] / ms.seg_l0)[:, None, None] * nn
         seg, seg_pair = (ms.seg_i, ms.seg_j), asm.seg_pair
@@ -159,16 +166,22 @@ def rank_one_terms(model: Model, x: np.ndarray, fs: FibreState | None, act: np.n
 
     Stiff fibres (along their whole length), active wall contacts (with the reaction on the mandible)
     and condyles on the fossa stop.  They update the banded factor by Woodbury, so a change of the
-    contact set does not refactor the band.
+    contact set does not refactor the band.  In a mirrored model a fibre and its twin have one folded
+    gradient: they enter as one term of twice the stiffness (half the Woodbury size).
     """
     n3 = 3 * model.n_nodes
     cols, ks = [], []
     if fs is not None:
-        kf = fibre_stiffness(model.muscles, fs, act, h)
+        kf = fibre_stiffness(model, fs, act, h)
         stiff = np.flatnonzero(kf >= _RANK_ONE_STIFFNESS)
+        k = kf[stiff]
+        if model.fibre_twin is not None:  # twins' gradients fold onto the same column: one, twice as stiff
+            twin = model.fibre_twin[stiff]
+            keep = twin >= stiff
+            stiff, k = stiff[keep], np.where(twin[keep] == stiff[keep], 1.0, 2.0) * k[keep]
         if len(stiff):
             cols.append(length_gradients(model.muscles, fs, stiff, model.n_nodes))
-            ks.append(kf[stiff])
+            ks.append(k)
     if planes is not None and active.any():
         nodes, n = planes.nodes[active], planes.n[active]
         v = np.zeros((model.n_nodes, 3, len(nodes)))

@@ -16,6 +16,7 @@ mandible carries, muscles, condyle guide, wall contact).
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
@@ -33,7 +34,7 @@ from .calibration import calibrate
 from .contact import ContactModel, contact_model
 from .elements import CylinderSet
 from .isotropy import isotropic_areas
-from .muscles import MuscleSet, muscle_set
+from .muscles import MuscleSet, fibre_twins, muscle_set
 from .prestress import weight_carrying
 
 
@@ -126,6 +127,7 @@ class Model:
     carried: Carried | None = None  # points that move rigidly with the mandible
     image: np.ndarray | None = None  # (N,) each node's mirror image, when the right half is solved for both
     mirrored: np.ndarray | None = None  # (H,) the nodes that move as their image's mirror (no dofs of their own)
+    fibre_twin: np.ndarray | None = None  # (F,) each fibre's mirror twin when mirrored (itself on the midline)
 
     def mirror(self, x: np.ndarray) -> np.ndarray:
         """``x`` (N,3) with each mirrored node put at its image's mirror place (in place, returned)."""
@@ -141,7 +143,7 @@ class Model:
     def n_tongue(self) -> int:
         return self.mesh.nodes.shape[0]
 
-    @property
+    @cached_property
     def volume_constraint(self) -> bool:
         return bool(np.any(self.kappa > 0))
 
@@ -445,4 +447,5 @@ def build_articulator(cfg: Config, mesh: Mesh, wall: WallSurface | None = None, 
                    node_sets=dict(body.node_sets), names=dict(body.names), muscles=ms,
                    groups={k: dict(v) for k, v in mc.groups.items()}, guide_spec=guide, contact=cm, wall=wall,
                    tone=tone, carried=carried_points(body.nodes, body.carried, body.carrier), mirror=mirror,
-                   image=None if mirror is None else image, mirrored=None if mirror is None else halves)
+                   image=None if mirror is None else image, mirrored=None if mirror is None else halves,
+                   fibre_twin=None if mirror is None else fibre_twins(ms, image))

@@ -159,6 +159,24 @@ def length_gradients(ms: MuscleSet, fs: FibreState, fibres: np.ndarray, n_nodes:
     return g.reshape(3 * n_nodes, -1)
 
 
+def fibre_twins(ms: MuscleSet, image: np.ndarray) -> np.ndarray | None:
+    """(F,) each fibre's mirror twin (the fibre of the same muscle along the mirror images of its nodes, in
+    either direction; itself on the midline or across it), or None if some fibre has no twin."""
+    chains = {}
+    for f in range(ms.n_fibres):
+        seg = np.flatnonzero(ms.seg_fibre == f)
+        chains[f] = (int(ms.fibre_muscle[f]), tuple(ms.seg_i[seg]) + (int(ms.seg_j[seg[-1]]),))
+    where = {c: f for f, c in chains.items()}
+    twin = np.empty(ms.n_fibres, dtype=np.int64)
+    for f, (m, chain) in chains.items():
+        mirrored = tuple(int(i) for i in image[list(chain)])
+        t = where.get((m, mirrored), where.get((m, mirrored[::-1])))
+        if t is None:
+            return None
+        twin[f] = t
+    return twin
+
+
 def muscle_forces(ms: MuscleSet, fs: FibreState) -> np.ndarray:
     """(N,3) nodal forces of all fibres."""
     if kernels.AVAILABLE and elements.USE_KERNELS:

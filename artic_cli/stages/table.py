@@ -32,9 +32,9 @@ class StageEntry:
     items: str = ""  # pipeline list the stage runs once per item of
     ok_status: tuple[int, ...] = (0,)  # exit statuses that still count as done (3: target unreachable, answer written)
     figures: tuple[Figure, ...] = field(default_factory=tuple)
-    # `make paper` runs it after every other stage and figure: it keeps both cores busy by itself, and beside
-    # other stages each slows the other more than their sum
-    last: bool = False
+    # `make paper` runs it alone: "first" before every stage it does not read, "last" after everything that does
+    # not read it.  For stages that keep both cores busy by themselves: beside another stage each slows the other.
+    alone: str = ""
 
 
 MESH = "{out}/mesh.h5"
@@ -52,6 +52,7 @@ STAGES: tuple[StageEntry, ...] = (
                                "artic_cli.plots.mesh", ("{out}/.config/vocal_tract.json",)),)),
     StageEntry("epmaps", "artic_cli.stages.epmap", MAPS,
                "ep-map --mesh {mesh} --config {config} --out {output} --jobs 2 --cache {out}/cache", inputs=(MESH,),
+               alone="first",
                figures=(Figure("{report}/fig8_epmap.png", "plot ep-map --maps {output}", "--out {figure}",
                                "artic_cli.plots.epmap"),)),
     StageEntry("dynamic", "artic_cli.stages.dynamic", DYN, "dynamic-map --maps {maps} --out {output}",
@@ -138,7 +139,7 @@ STAGES: tuple[StageEntry, ...] = (
                                "artic_cli.plots.muscle_function", items="fig7"),)),
     StageEntry("musclefunction", "artic_cli.stages.muscle_function", "{out}/muscle_function.h5",
                "muscle-function --mesh {mesh} --config {config} --out {output} --jobs 2 --cache {out}/cache",
-               inputs=(MESH,), last=True,
+               inputs=(MESH,), alone="last",
                figures=(Figure("{report}/fig5_muscle_function_tip.png", MF_PLOT, "--tip {figure}",
                                "artic_cli.plots.muscle_function"),
                         Figure("{report}/fig6_muscle_function_dorsum.png", MF_PLOT, "--dorsum {figure}",

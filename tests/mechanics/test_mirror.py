@@ -93,3 +93,35 @@ def test_the_dorsum_pressed_on_the_palate_stays_mirrored(pair):
     assert np.abs(half[:, image] * [1.0, 1.0, -1.0] - half).max() < 1e-4
     assert np.abs(half - whole).max() < 0.05
     assert np.abs(whole[-1] - whole[0]).max() > 0.5  # it did move
+
+
+def test_mirror_twin_fibres_enter_newton_as_one_term(art_half):
+    """Every fibre has a mirror twin (itself when on or across the midline); a twin pair's folded length
+    gradients are one column, so the rank-one part of Newton's matrix keeps one term of twice the stiffness
+    and comes out the same as with every fibre on its own."""
+    from dataclasses import replace
+
+    from artic_cli.control.equilibrium import control_for
+    from artic_cli.mechanics.integrator import rank_one_terms, step, total_muscle_force
+    from artic_cli.mechanics.model import rest_state
+    from artic_cli.mechanics.muscles import fibre_state
+
+    twin = art_half.fibre_twin
+    n = art_half.muscles.n_fibres
+    assert twin is not None and (twin[twin] == np.arange(n)).all() and 0 < (twin == np.arange(n)).sum() < n
+    ms = art_half.muscles
+    assert (ms.fibre_muscle[twin] == ms.fibre_muscle).all() and np.allclose(ms.fibre_l0[twin], ms.fibre_l0)
+    ctl = control_for(art_half, {"SG": 3.0, "HG": 2.0, "GGp": 1.0})
+    s = rest_state(art_half)
+    for _ in range(6):
+        s = step(art_half, s, ctl)
+    act = total_muscle_force(art_half, ctl.muscle_force)
+    fs = fibre_state(ms, s.x, act, s.sigma2, s.fibre_strain, art_half.options.dt)
+    none = np.zeros(0, dtype=bool)
+    red_t = art_half.pattern.reduce_t
+    merged = rank_one_terms(art_half, s.x, fs, act, art_half.options.dt, None, none)
+    apart = rank_one_terms(replace(art_half, fibre_twin=None), s.x, fs, act, art_half.options.dt, None, none)
+    assert 0 < len(merged[1]) < len(apart[1])
+    g1, g0 = red_t @ merged[0], red_t @ apart[0]
+    a1, a0 = g1 @ np.diag(merged[1]) @ g1.T, g0 @ np.diag(apart[1]) @ g0.T
+    assert np.abs(a1 - a0).max() <= 1e-9 * np.abs(a0).max()

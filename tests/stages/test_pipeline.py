@@ -173,3 +173,23 @@ def test_the_ci_pipeline_is_the_paper_pipeline_with_fewer_utterances():
     drop = {"pipeline", "utterances"}
     assert paper.model_dump(exclude=drop) == ci.model_dump(exclude=drop)
     assert ci.utterances and set(ci.utterances) <= set(paper.utterances)
+
+
+def test_make_paper_runs_the_ep_maps_first_and_the_muscle_function_study_last_each_alone():
+    """Under `make paper` (two stages at a time) every stage that does not feed the EP maps waits for them, and
+    the muscle-function study waits for everything but its own figures; other goals are left unordered."""
+    from artic_cli.pipeline import load_pipeline, render
+
+    text = render(load_pipeline(ROOT / "pipelines" / "paper.yaml"))
+    block = text.split("ifneq ($(filter paper,$(MAKECMDGOALS)),)\n")[1].split("\nendif")[0].splitlines()
+    stamps = {ln.split(":")[0] for ln in text.splitlines() if ln.startswith("$(OUT)/.stamps/") and ": " in ln
+              and "|" in ln and not ln.split(":")[1].startswith(" |")}
+    first = {ln.split(":")[0] for ln in block if ln.endswith(": | $(OUT)/epmaps.h5")}
+    assert "$(OUT)/.stamps/mesh/mesh" not in first and "$(OUT)/.stamps/epmaps/epmaps" not in first
+    assert first == stamps - {"$(OUT)/.stamps/mesh/mesh", "$(OUT)/.stamps/epmaps/epmaps"}
+    last = [ln for ln in block if ln.startswith("$(OUT)/.stamps/musclefunction/musclefunction: | $(OUT)/mesh.h5")]
+    assert len(last) == 1
+    waits = set(last[0].split("| ")[1].split())
+    assert {"$(OUT)/epmaps.h5", "$(OUT)/utterances/aia.h5", "$(REPORT)/fig8_epmap.png"} <= waits
+    assert not any("muscle_function" in w or "fig5" in w for w in waits)
+    assert "MAKEFLAGS += -j$(JOBS)" in (ROOT / "Makefile").read_text()
