@@ -76,17 +76,20 @@ def fibre_stiffness(model: Model, fs: FibreState, act: np.ndarray, h: float) -> 
     return kf if model.fibre_twin is None else 0.5 * (kf + kf[model.fibre_twin])
 
 
-def guide_forces(model: Model, x: np.ndarray) -> np.ndarray:
+def guide_forces(model: Model, x: np.ndarray, stop: np.ndarray | None = None) -> np.ndarray:
+    """The condyle guide's forces (dyn); ``stop``: which guided nodes press on their back stop
+    (:func:`guide_stop`, computed when not given)."""
     f = np.zeros_like(x)
     gd = model.guide
     if gd is not None:
         d = x[gd.nodes] - gd.origin
-        off = np.einsum("gi,gmi->gm", d, gd.normals)
-        f[gd.nodes] = -gd.stiffness * np.einsum("gm,gmi->gi", off, gd.normals)
-        behind = guide_stop(gd, x)
-        if behind.any():
-            push, _ = ramp(-np.einsum("gi,gi->g", d, gd.path), gd.onset)
-            f[gd.nodes] += gd.stiffness * push[:, None] * gd.path
+        off = (d[:, None, :] * gd.normals).sum(axis=2)  # (G,2)
+        fg = -gd.stiffness * (off[:, :, None] * gd.normals).sum(axis=1)
+        stop = guide_stop(gd, x) if stop is None else stop
+        if stop.any():
+            push, _ = ramp(-(d * gd.path).sum(axis=1), gd.onset)
+            fg += gd.stiffness * push[:, None] * gd.path
+        f[gd.nodes] = fg
     return f
 
 
@@ -102,7 +105,7 @@ def guide_stop(gd, x: np.ndarray) -> np.ndarray:
     """(G,) which guided nodes press on the back stop of their line."""
     if gd is None or gd.path is None:
         return np.zeros(0 if gd is None else len(gd.nodes), dtype=bool)
-    return np.einsum("gi,gi->g", x[gd.nodes] - gd.origin, gd.path) < 0.0
+    return ((x[gd.nodes] - gd.origin) * gd.path).sum(axis=1) < 0.0
 
 
 def contact_forces(model: Model, x: np.ndarray, planes: ContactPlanes | None):
@@ -123,8 +126,9 @@ def contact_forces(model: Model, x: np.ndarray, planes: ContactPlanes | None):
 
 def tangent(model: Model, cs: elements.CylinderState, frame: elements.DampingFrame, grad,
             fs: FibreState | None, act: np.ndarray | None, h: float, c_a: float, c_v: float,
-            signed_geometry: bool = True):
-    """The banded part of the Newton matrix: mass, cylinders and links, volume, fibres' own blocks, guide."""
+            signed_geometry: bool = True, kf: np.ndarray | None = None):
+    """The banded part of the Newton matrix: mass, cylinders and links, volume, fibres' own blocks, guide
+    (``kf``: the fibres' stiffness, :func:`fibre_stiffness`, computed when not given)."""
     # geometric stiffness T / l with its sign: compressed cylinders soften sideways (the mass term keeps
     # the matrix positive definite at these loads; a failed factorisation falls back to clipping)
     cyl, asm = model.springs, model.assembly
@@ -136,7 +140,7 @@ def tangent(model: Model, cs: elements.CylinderState, frame: elements.DampingFra
     if fs is not None:
         t = np.maximum(fs.tension[ms.seg_fibre], 0.0) / fs.seg_length
         nn = fs.n[:, :, None] * fs.n[:, None, :]
-        kf = fibre_stiffness(model, fs, act, h)
+        kf = fibre_stiffness(model, fs, act, h) if kf is None else kf
         soft = np.where(kf < _RANK_ONE_STIFFNESS, kf * ms.fibre_l0, 0.0)  # split in series
         k_seg = t[:, None, None] * (_EYE - nn) + (soft[ms.seg_fibre] / ms.seg_l0)[:, None, None] * nn
         seg, seg_pair = (ms.seg_i, ms.seg_j), asm.seg_pair
@@ -161,18 +165,20 @@ def tangent(model: Model, cs: elements.CylinderState, frame: elements.DampingFra
 
 
 def rank_one_terms(model: Model, x: np.ndarray, fs: FibreState | None, act: np.ndarray | None, h: float,
-                   planes: ContactPlanes | None, active: np.ndarray, guard=None) -> tuple[np.ndarray, np.ndarray]:
+                   planes: ContactPlanes | None, active: np.ndarray, guard=None, stop: np.ndarray | None = None,
+                   kf: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Newton terms k v v^T that change often or do not fit the band: (V (3N, r), k (r,)).
 
     Stiff fibres (along their whole length), active wall contacts (with the reaction on the mandible)
     and condyles on the fossa stop.  They update the banded factor by Woodbury, so a change of the
     contact set does not refactor the band.  In a mirrored model a fibre and its twin have one folded
-    gradient: they enter as one term of twice the stiffness (half the Woodbury size).
+    gradient: they enter as one term of twice the stiffness (half the Woodbury size).  ``stop``
+    (:func:`guide_stop`) and ``kf`` (:func:`fibre_stiffness`) are computed when not given.
     """
     n3 = 3 * model.n_nodes
     cols, ks = [], []
     if fs is not None:
-        kf = fibre_stiffness(model, fs, act, h)
+        kf = fibre_stiffness(model, fs, act, h) if kf is None else kf
         stiff = np.flatnonzero(kf >= _RANK_ONE_STIFFNESS)
         k = kf[stiff]
         if model.fibre_twin is not None:  # twins' gradients fold onto the same column: one, twice as stiff
@@ -197,13 +203,13 @@ def rank_one_terms(model: Model, x: np.ndarray, fs: FibreState | None, act: np.n
         np.add.at(v, (model.bricks[b], slice(None), np.arange(len(b))[:, None]), g)
         cols.append(v.reshape(n3, -1))
         ks.append(w)
-    stop = guide_stop(model.guide, x)
+    stop = guide_stop(model.guide, x) if stop is None else stop
     if stop.any():
         gd = model.guide
         v = np.zeros((model.n_nodes, 3, int(stop.sum())))
         v[gd.nodes[stop], :, np.arange(int(stop.sum()))] = gd.path[stop]
         cols.append(v.reshape(n3, -1))
-        _, slope = ramp(-np.einsum("gi,gi->g", x[gd.nodes[stop]] - gd.origin[stop], gd.path[stop]), gd.onset)
+        _, slope = ramp(-((x[gd.nodes[stop]] - gd.origin[stop]) * gd.path[stop]).sum(axis=1), gd.onset)
         ks.append(gd.stiffness * slope)
     if not cols:
         return np.zeros((n3, 0)), np.zeros(0)
@@ -295,26 +301,28 @@ def _step_once(model: Model, state: State, control: Control, h: float) -> State:
         a = c_a * x + a_known
         v = c_v * x + v_known
         f_int, cs, _, grad, guard = internal_forces(model, x, v, frame)
-        f = f_int + guide_forces(model, x)
+        stop = guide_stop(model.guide, x)
+        f = f_int + guide_forces(model, x, stop)
         if ms is not None:
             fs = fibre_state(ms, x, act, state.sigma2, state.fibre_strain, h)
             f += muscle_forces(ms, fs)
         fc, active, _ = contact_forces(model, x, planes)
         f += fc
-        active_key = (None if planes is None else tuple(planes.nodes[active]), tuple(guide_stop(model.guide, x)),
+        active_key = (None if planes is None else tuple(planes.nodes[active]), tuple(stop),
                       () if guard is None else tuple(zip(guard[0].tolist(), guard[1].tolist())))
         if factor is not None and active_key != factor.terms_key:
             factor = None  # contact set changed: keep the band, redo the small Woodbury part
         resid = reduce_t @ (model.mass @ a - f - f_ext).ravel()
         if factor is None:
             try:
+                kf = None if fs is None else fibre_stiffness(model, fs, act, h)
                 if base is None:
                     try:
-                        base = factorize(tangent(model, cs, frame, grad, fs, act, h, c_a, c_v), key)
+                        base = factorize(tangent(model, cs, frame, grad, fs, act, h, c_a, c_v, kf=kf), key)
                     except np.linalg.LinAlgError:
-                        base = factorize(tangent(model, cs, frame, grad, fs, act, h, c_a, c_v, False), key)
+                        base = factorize(tangent(model, cs, frame, grad, fs, act, h, c_a, c_v, False, kf), key)
                     refactors += 1
-                vecs, ks = rank_one_terms(model, x, fs, act, h, planes, active, guard)
+                vecs, ks = rank_one_terms(model, x, fs, act, h, planes, active, guard, stop, kf)
                 factor = add_low_rank(base, np.asarray(reduce_t @ vecs), ks, active_key)
             except np.linalg.LinAlgError:
                 raise SimulationDiverged(f"the tissue lost stability at t = {state.t * 1e3:.1f} ms (tangent not "

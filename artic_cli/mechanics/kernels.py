@@ -5,7 +5,8 @@
 * bricks: volume and inversion-guard terms with their gradients (``brick_terms``);
 * the wall: exact candidate grids and the closest triangle of each point, and the mandible's rigid motion
   (``grid_candidates``, ``wall_nearest``, ``rigid_motion``);
-* muscle fibres: segment geometry and nodal forces (``fibre_geometry``, ``fibre_forces``).
+* muscle fibres: segment geometry, nodal forces and length gradients (``fibre_geometry``, ``fibre_forces``,
+  ``fibre_gradients``).
 
 Without numba the functions run as plain Python (slowly); numba is a dependency.
 """
@@ -463,3 +464,44 @@ def fibre_forces(n, tension, seg_i, seg_j, seg_fibre, n_nodes):
             f[seg_i[k], i] += t * n[k, i]
             f[seg_j[k], i] -= t * n[k, i]
     return f
+
+
+@njit(cache=True, fastmath=False)
+def fibre_gradients(n, seg_i, seg_j, seg_col, n_nodes, r):
+    """(N,3,r) gradient of fibre lengths: column ``seg_col[k]`` (-1: none) gets +n at seg_j, -n at seg_i."""
+    g = np.zeros((n_nodes, 3, r))
+    for k in range(len(seg_i)):
+        c = seg_col[k]
+        if c < 0:
+            continue
+        for i in range(3):
+            g[seg_j[k], i, c] += n[k, i]
+            g[seg_i[k], i, c] -= n[k, i]
+    return g
+
+
+@njit(cache=True, fastmath=False, error_model="numpy")
+def fibre_tensions(total, l0, sigma2_prev, strain_prev, h, k1, k2, b2, activation, fibre_muscle, share, area,
+                   width, coeffs, lo, hi):
+    """Strain, Maxwell stress and tension of every fibre (:func:`..muscles.fibre_state`'s numbers) from its
+    length ``total``; ``coeffs`` Eq. (9) highest power first, zero outside ``lo < e / width < hi``."""
+    nf = len(total)
+    strain = np.empty(nf)
+    sigma2 = np.empty(nf)
+    tension = np.empty(nf)
+    relax = 1.0 + h * k2 / b2 if h > 0 else 1.0
+    for f in range(nf):
+        e = total[f] / l0[f] - 1.0
+        s2 = (sigma2_prev[f] + k2 * (e - strain_prev[f])) / relax if h > 0 else sigma2_prev[f]
+        passive = k1 * max(e, 0.0) * e + s2
+        u = e / width
+        fl = 0.0
+        if lo < u < hi:
+            p = coeffs[0]
+            for c in coeffs[1:]:
+                p = p * u + c
+            fl = max(p / coeffs[-1], 0.0)
+        strain[f] = e
+        sigma2[f] = s2
+        tension[f] = activation[fibre_muscle[f]] * share[f] * fl + area[f] * passive
+    return strain, sigma2, tension

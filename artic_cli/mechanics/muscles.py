@@ -29,6 +29,7 @@ from . import elements, kernels
 FL_COEFFS = (22.5, 3.498, -14.718, 1.98, 0.858)  # Eq. (9), highest power first
 FL_RANGE = (-0.185, 0.49)
 FL_SLOPE_COEFFS = tuple(float(c) for c in np.polyder(FL_COEFFS))
+_FL = np.array(FL_COEFFS)
 
 
 def _polyval(coeffs, e: np.ndarray) -> np.ndarray:
@@ -123,6 +124,11 @@ def fibre_state(ms: MuscleSet, x: np.ndarray, activation: np.ndarray, sigma2_pre
     if kernels.AVAILABLE and elements.USE_KERNELS:
         n, length, total = kernels.fibre_geometry(np.ascontiguousarray(x), ms.seg_i, ms.seg_j, ms.seg_fibre,
                                                   ms.n_fibres)
+        strain, sigma2, tension = kernels.fibre_tensions(
+            total, ms.fibre_l0, sigma2_prev, strain_prev, float(h), ms.k1, ms.k2, ms.b2,
+            np.asarray(activation, dtype=float), ms.fibre_muscle, ms.fibre_share, ms.fibre_area, ms.fl_width,
+            _FL, *FL_RANGE)
+        return FibreState(n=n, seg_length=length, strain=strain, tension=tension, sigma2=sigma2)
     else:
         d = ms.diff @ x
         length = np.sqrt((d * d).sum(axis=1))
@@ -149,9 +155,12 @@ def fibre_stiffness(ms: MuscleSet, fs: FibreState, activation: np.ndarray, h: fl
 
 def length_gradients(ms: MuscleSet, fs: FibreState, fibres: np.ndarray, n_nodes: int) -> np.ndarray:
     """(3N, len(fibres)) gradient of each chosen fibre's length with respect to the node positions."""
-    g = np.zeros((n_nodes, 3, len(fibres)))
     col = np.full(ms.n_fibres, -1)
     col[fibres] = np.arange(len(fibres))
+    if kernels.AVAILABLE and elements.USE_KERNELS:
+        return kernels.fibre_gradients(fs.n, ms.seg_i, ms.seg_j, col[ms.seg_fibre], n_nodes,
+                                       len(fibres)).reshape(3 * n_nodes, -1)
+    g = np.zeros((n_nodes, 3, len(fibres)))
     seg = np.flatnonzero(col[ms.seg_fibre] >= 0)
     c = col[ms.seg_fibre[seg]]
     np.add.at(g, (ms.seg_j[seg], slice(None), c), fs.n[seg])
