@@ -25,6 +25,10 @@ class Row:
     verdict: str
 
 
+# make paper runs two stages at a time: a stage's own clock may have shared the cores
+_BESIDE = "timed as make paper ran it, maybe beside another stage; make bench times it alone and splits the time"
+
+
 def _extension(attrs) -> str:
     ext = float(attrs.get("extend_ms", 0.0))
     return f" and up to {ext:g} ms more" if ext > 0 else ""
@@ -81,7 +85,7 @@ def tissue_rows(data: Path) -> list[Row]:
                     f"{'finite' if finite else 'NaN'}, {inv} inverted bricks, volume change {100 * vst:.3f} %",
                     _verdict(finite and inv == 0 and vst <= 0.003, "no NaN, no inversion, volume <= 0.3 %")))
     rows.append(Row("Computation speed (wall time per simulated second)", "about 40", f"{ratio:.3f}",
-                    _verdict(ratio <= 40, f"{40 / ratio:.0f} times faster than the paper")))
+                    _verdict(ratio <= 40, f"{40 / ratio:.0f} times faster than the paper; {_BESIDE}")))
     return rows
 
 
@@ -159,7 +163,7 @@ def articulator_rows(data: Path) -> list[Row]:
         ratio = float(f.attrs["wall_time_s"]) / float(f["time"][-1])
     rows.append(Row("Articulator speed (wall time per simulated second; SG 4 N + JO 3 N for 300 ms)", "about 40",
                     f"{ratio:.2f}", _verdict(ratio <= 0.5, f"goal <= 0.5, {40 / ratio:.0f} times faster than the "
-                                                           "paper; make bench splits the time")))
+                                                           f"paper; {_BESIDE}")))
     return rows
 
 
