@@ -172,7 +172,7 @@ def rank_one_terms(model: Model, x: np.ndarray, fs: FibreState | None, act: np.n
     Stiff fibres (along their whole length), active wall contacts (with the reaction on the mandible)
     and condyles on the fossa stop.  They update the banded factor by Woodbury, so a change of the
     contact set does not refactor the band.  In a mirrored model a fibre and its twin have one folded
-    gradient: they enter as one term of twice the stiffness (half the Woodbury size).  ``stop``
+    gradient: they enter as one term of twice the stiffness (fewer Woodbury columns).  ``stop``
     (:func:`guide_stop`) and ``kf`` (:func:`fibre_stiffness`) are computed when not given.
     """
     n3 = 3 * model.n_nodes
