@@ -11,8 +11,8 @@ override OUT := $(patsubst %/,%,$(OUT))
 REPORT   ?= $(if $(filter data,$(OUT)),reports,$(OUT)/reports)
 PIPELINE ?= pipelines/paper.yaml
 FIG9_JAW ?= JO_2.5
-# `make paper` runs JOBS stages at a time (JOBS=1: one after another); the muscle-function study, which keeps
-# both cores busy by itself, runs last, alone (the stage table's `last`)
+# `make paper` runs JOBS stages at a time (JOBS=1: one after another); the stages that keep both cores busy by
+# themselves run alone (the stage table's `alone`: the EP maps first, the muscle-function study last)
 JOBS     ?= 2
 ifneq ($(filter paper,$(MAKECMDGOALS)),)
 MAKEFLAGS += -j$(JOBS)

@@ -161,8 +161,8 @@ def _alone_rules(alone: dict, stamps: dict, reads: dict, made: list[str]) -> lis
                 upstream.add(x)
                 todo += reads[x]
         lines += [f"{s}: | {own[0]}" for o, s in stamps.items() if o not in upstream and o not in own]
-    for stamp, own in alone["last"]:
-        lasts = {x for _, o in alone["last"] for x in o}
+    lasts = {x for _, own in alone["last"] for x in own}
+    for stamp, _ in alone["last"]:
         lines.append(f"{stamp}: | {' '.join(x for x in made if x not in lasts)}")
     return ["ifneq ($(filter paper,$(MAKECMDGOALS)),)", *lines, "endif", ""] if lines else []
 

@@ -27,7 +27,7 @@ from .assembly import add_low_rank, factorize
 from .contact import ContactPlanes, contact_planes, enforce
 from .model import Control, Model, State
 from .penalty import ramp
-from .muscles import FibreState, fibre_state, fibre_stiffness as _fibre_stiffness, length_gradients, muscle_forces
+from .muscles import FibreState, fibre_state, fibre_stiffness, length_gradients, muscle_forces
 from ..geometry.hexahedra import SHAPE_GRADIENTS_CORNER, SHAPE_GRADIENTS_GAUSS
 from .volume import GUARD_FRACTION, corner_guard, volume_forces
 
@@ -69,10 +69,10 @@ def internal_forces(model: Model, x: np.ndarray, v: np.ndarray | None = None,
     return f, cs, vol, grad, guard
 
 
-def fibre_stiffness(model: Model, fs: FibreState, act: np.ndarray, h: float) -> np.ndarray:
+def _fibre_stiffness(model: Model, fs: FibreState, act: np.ndarray, h: float) -> np.ndarray:
     """(F,) the fibres' stiffness along their length (:func:`.muscles.fibre_stiffness`); a mirrored model's
     twins get their mean, so that both fall on the same side of the rank-one threshold."""
-    kf = _fibre_stiffness(model.muscles, fs, act, h)
+    kf = fibre_stiffness(model.muscles, fs, act, h)
     return kf if model.fibre_twin is None else 0.5 * (kf + kf[model.fibre_twin])
 
 
@@ -128,7 +128,7 @@ def tangent(model: Model, cs: elements.CylinderState, frame: elements.DampingFra
             fs: FibreState | None, act: np.ndarray | None, h: float, c_a: float, c_v: float,
             signed_geometry: bool = True, kf: np.ndarray | None = None):
     """The banded part of the Newton matrix: mass, cylinders and links, volume, fibres' own blocks, guide
-    (``kf``: the fibres' stiffness, :func:`fibre_stiffness`, computed when not given)."""
+    (``kf``: the fibres' stiffness, :func:`_fibre_stiffness`, computed when not given)."""
     # geometric stiffness T / l with its sign: compressed cylinders soften sideways (the mass term keeps
     # the matrix positive definite at these loads; a failed factorisation falls back to clipping)
     cyl, asm = model.springs, model.assembly
@@ -140,7 +140,7 @@ def tangent(model: Model, cs: elements.CylinderState, frame: elements.DampingFra
     if fs is not None:
         t = np.maximum(fs.tension[ms.seg_fibre], 0.0) / fs.seg_length
         nn = fs.n[:, :, None] * fs.n[:, None, :]
-        kf = fibre_stiffness(model, fs, act, h) if kf is None else kf
+        kf = _fibre_stiffness(model, fs, act, h) if kf is None else kf
         soft = np.where(kf < _RANK_ONE_STIFFNESS, kf * ms.fibre_l0, 0.0)  # split in series
         k_seg = t[:, None, None] * (_EYE - nn) + (soft[ms.seg_fibre] / ms.seg_l0)[:, None, None] * nn
         seg, seg_pair = (ms.seg_i, ms.seg_j), asm.seg_pair
@@ -173,12 +173,12 @@ def rank_one_terms(model: Model, x: np.ndarray, fs: FibreState | None, act: np.n
     and condyles on the fossa stop.  They update the banded factor by Woodbury, so a change of the
     contact set does not refactor the band.  In a mirrored model a fibre and its twin have one folded
     gradient: they enter as one term of twice the stiffness (fewer Woodbury columns).  ``stop``
-    (:func:`guide_stop`) and ``kf`` (:func:`fibre_stiffness`) are computed when not given.
+    (:func:`guide_stop`) and ``kf`` (:func:`_fibre_stiffness`) are computed when not given.
     """
     n3 = 3 * model.n_nodes
     cols, ks = [], []
     if fs is not None:
-        kf = fibre_stiffness(model, fs, act, h) if kf is None else kf
+        kf = _fibre_stiffness(model, fs, act, h) if kf is None else kf
         stiff = np.flatnonzero(kf >= _RANK_ONE_STIFFNESS)
         k = kf[stiff]
         if model.fibre_twin is not None:  # twins' gradients fold onto the same column: one, twice as stiff
@@ -315,7 +315,7 @@ def _step_once(model: Model, state: State, control: Control, h: float) -> State:
         resid = reduce_t @ (model.mass @ a - f - f_ext).ravel()
         if factor is None:
             try:
-                kf = None if fs is None else fibre_stiffness(model, fs, act, h)
+                kf = None if fs is None else _fibre_stiffness(model, fs, act, h)
                 if base is None:
                     try:
                         base = factorize(tangent(model, cs, frame, grad, fs, act, h, c_a, c_v, kf=kf), key)

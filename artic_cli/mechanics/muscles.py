@@ -129,11 +129,10 @@ def fibre_state(ms: MuscleSet, x: np.ndarray, activation: np.ndarray, sigma2_pre
             np.asarray(activation, dtype=float), ms.fibre_muscle, ms.fibre_share, ms.fibre_area, ms.fl_width,
             _FL, *FL_RANGE)
         return FibreState(n=n, seg_length=length, strain=strain, tension=tension, sigma2=sigma2)
-    else:
-        d = ms.diff @ x
-        length = np.sqrt((d * d).sum(axis=1))
-        n = d / length[:, None]
-        total = ms.seg_sum @ length
+    d = ms.diff @ x
+    length = np.sqrt((d * d).sum(axis=1))
+    n = d / length[:, None]
+    total = ms.seg_sum @ length
     strain = total / ms.fibre_l0 - 1.0
     sigma2 = (sigma2_prev + ms.k2 * (strain - strain_prev)) / (1.0 + h * ms.k2 / ms.b2) if h > 0 else sigma2_prev
     passive = ms.k1 * np.maximum(strain, 0.0) * strain + sigma2
