@@ -16,6 +16,12 @@ FIG9_JAW ?= JO_2.5
 JOBS     ?= 2
 ifneq ($(filter paper,$(MAKECMDGOALS)),)
 MAKEFLAGS += -j$(JOBS)
+# the report's "This run" row: when this make paper started, whether OUT held no artefact then, JOBS (written
+# once: make restarts itself after remaking the generated rules)
+ifeq ($(MAKE_RESTARTS),)
+$(shell mkdir -p $(OUT) && echo "$$(date +%s.%N) $(if $(wildcard $(OUT)/*.h5),0,1) $(JOBS)" > $(OUT)/.paper_run)
+endif
+export ARTIC_PAPER_RUN := $(shell cat $(OUT)/.paper_run 2>/dev/null)
 endif
 
 # one BLAS/OpenMP thread per process: the systems are small, parallelism comes from processes, and a spare
@@ -70,4 +76,4 @@ bench: setup $(OUT)/epmaps.h5 $(OUT)/dynamic.h5
 clean:
 	rm -rf $(OUT)/*.h5 $(OUT)/*.json $(OUT)/sims $(OUT)/experiments $(OUT)/solutions $(OUT)/cache $(OUT)/.stamps \
 	  $(OUT)/tracts $(OUT)/acoustics $(OUT)/audio $(OUT)/vowels $(OUT)/utterances \
-	  $(OUT)/.config $(PIPELINE_MK) $(REPORT)/*.png $(REPORT)/*.gif $(REPORT)/paper.md
+	  $(OUT)/.config $(OUT)/.paper_run $(PIPELINE_MK) $(REPORT)/*.png $(REPORT)/*.gif $(REPORT)/paper.md

@@ -165,6 +165,7 @@ REPORT: tuple[ReportSection, ...] = (
                   ("epmaps", "dynamic", "solve")),
     ReportSection("vowels", "Vowels from formant targets (beyond the paper)", ("vowels", "vowels-audio")),
     ReportSection("utterances", "Utterances from target sequences (beyond the paper)", ("utterances",)),
+    ReportSection("run", "This run", ()),
 )
 REPORT_MODULE = "artic_cli.stages.report"
 REPORT_OUTPUT = "{report}/paper.md"

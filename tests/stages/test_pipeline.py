@@ -60,6 +60,8 @@ def test_every_report_row_has_a_computed_value(built):
         ours, verdict = cells[2], cells[3]
         assert ours and ours.lower() not in ("nan", "none", "n/a"), row
         assert re.match(r"(agrees|differs) \(", verdict), row
+    run = [r for r in rows if r.startswith("| make paper's wall time")]  # the Makefile timed this run
+    assert len(run) == 1 and re.search(r"\| \d+\.\d min \(2 stages at a time, from scratch\) \|", run[0]), run
 
 
 def test_every_figure_is_a_real_png(built):
