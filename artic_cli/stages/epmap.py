@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
 
+import h5py
 import numpy as np
 
 from ..config import Config, load_config
@@ -155,9 +156,21 @@ def write(path: Path | str, maps: EPMaps, cfg: Config, prov=None, fast: bool = F
                         f"cm moved over the last {cfg.epmap.convergence_window_ms:g} ms")
 
 
-def read(path: Path | str = "data/epmaps.h5", mesh: Path | str | None = None) -> EPMaps:
+def _array(group, name: str) -> np.ndarray:
+    """A whole dataset of ``group``, read through h5py's low-level API: the maps hold about a thousand small
+    datasets, and the high-level one spends most of a load on each one's Python wrapper (0.3 s -> 0.1 s)."""
+    d = h5py.h5d.open(group.id, name.encode())
+    out = np.empty(d.shape, dtype=d.dtype)
+    if out.size:
+        d.read(h5py.h5s.ALL, h5py.h5s.ALL, out)
+    return out[()] if out.ndim == 0 else out
+
+
+def read(path: Path | str = "data/epmaps.h5", mesh: Path | str | None = None, shapes: bool = True) -> EPMaps:
     """Maps written by :func:`build_ep_maps` (``attrs`` holds the root attributes, ``content_sha256`` among
-    them); with ``mesh``, checks they were built from that mesh's content."""
+    them); with ``mesh``, checks they were built from that mesh's content.  ``shapes=False`` leaves the EPs'
+    whole shapes out (the control points are what a spatial target is solved on; the shapes are most of the
+    file)."""
     path = Path(path)
     hint = STAGE.hint
     mesh_sha = None if mesh is None else mesh_stage.read(mesh).content_sha256
@@ -168,19 +181,20 @@ def read(path: Path | str = "data/epmaps.h5", mesh: Path | str | None = None) ->
             jaws = {}
             for jname in f.attrs["jaw_order"]:
                 g = f["jaw_positions"][jname]
-                rest = np.array([g["rest"][cp][()] for cp in CONTROL_POINTS])
+                r = g["rest"]
+                rest = np.array([_array(r, cp) for cp in CONTROL_POINTS])
                 jm = JawMaps(forces=json.loads(g.attrs["jaw_forces_n"]), rest=rest, single={},
-                             mandible=g["rest"]["mandible"][()] if "mandible" in g["rest"] else None,
-                             rest_shape=g["rest"]["shape"][()] if "shape" in g["rest"] else None)
+                             mandible=_array(r, "mandible") if "mandible" in r else None,
+                             rest_shape=_array(r, "shape") if shapes and "shape" in r else None)
                 for fam in ("single", "pair", "group"):
                     for name in g.attrs[f"{fam}_order"]:
                         n = g[fam][name]
                         muscles = tuple(n.attrs["muscles"])
-                        levels = tuple(n[f"force_{k}_n"][()] for k in range(len(muscles)))
-                        x = np.stack([n[cp][()] for cp in CONTROL_POINTS], axis=-2)
+                        levels = tuple(_array(n, f"force_{k}_n") for k in range(len(muscles)))
+                        x = np.stack([_array(n, cp) for cp in CONTROL_POINTS], axis=-2)
                         getattr(jm, fam)[name] = Net(muscles=muscles, levels=levels, x=x,
-                                                     converged=n["converged"][()], drift_cm=n["drift_cm"][()],
-                                                     shapes=n["shape"][()] if "shape" in n else None)
+                                                     converged=_array(n, "converged"), drift_cm=_array(n, "drift_cm"),
+                                                     shapes=_array(n, "shape") if shapes and "shape" in n else None)
                 jaws[jname] = jm
             attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()}
             return EPMaps(jaws=jaws, typical_jaw=str(f.attrs["typical_jaw"]), attrs=attrs,

@@ -26,8 +26,9 @@ STAGE = Stage(name="solve", module=__name__, sections=(*SPATIAL_SECTIONS, "vocal
 def load_context(maps: Path | str = "data/epmaps.h5", dynamic: Path | str | None = "data/dynamic.h5",
                  mesh: Path | str | None = None) -> Context:
     """The maps (checked against ``mesh``'s content when given) and the dynamic map (checked against the
-    maps) a target is solved on."""
-    m = epmap_stage.read(maps, mesh=mesh)
+    maps) a target is solved on; the EPs' control points, not their whole shapes (``add_formants`` reads those
+    when it needs them)."""
+    m = epmap_stage.read(maps, mesh=mesh, shapes=False)
     dm = None
     if dynamic is not None and Path(dynamic).is_file():
         dm = dynamic_stage.read(dynamic, maps_path=maps)
@@ -59,6 +60,7 @@ def add_formants(ctx: Context, maps: Path | str, mesh: Path | str, config: Path 
         stored = am_stage.read(acoustic_maps)
         ctx.acoustic_sha256 = str(stored_content_hash(acoustic_maps))
     cache: dict = {}
+    whole: list = []  # the maps with the EPs' shapes, read once when other lips or ports need them
 
     def formants(jaw: str, area: float, length: float, port: float) -> dict:
         key = (jaw, round(area, 6), round(length, 6), round(port, 6))
@@ -66,7 +68,9 @@ def add_formants(ctx: Context, maps: Path | str, mesh: Path | str, config: Path 
             if stored is not None and jaw in stored.jaws and key[1:] == tuple(round(v, 6) for v in defaults):
                 nets = stored.jaws[jaw]
             else:
-                nets = am_stage.compute(cfg, m.mesh, ctx.maps, jaws=[jaw], overrides={
+                if not whole:
+                    whole.append(epmap_stage.read(maps))
+                nets = am_stage.compute(cfg, m.mesh, whole[0], jaws=[jaw], overrides={
                     "lip_area_cm2": area, "lip_length_cm": length, "velum_port_cm2": port}).jaws[jaw]
             cache[key] = {k: n.formants_hz for k, n in nets.items()}
         return cache[key]

@@ -122,6 +122,26 @@ def test_map_file_is_plain_hdf5_with_units_and_provenance(small, cfg):
         assert np.allclose(net["tip"][1, 0], f["jaw_positions/JO_0.5/single/SG/tip"][1])
 
 
+def test_the_maps_read_back_as_written_with_or_without_the_shapes(small):
+    tmp, _, _ = small
+    whole, light = load_ep_maps(tmp / "maps.h5"), load_ep_maps(tmp / "maps.h5", shapes=False)
+    with h5py.File(tmp / "maps.h5", "r") as f:
+        for jaw, jm in whole.jaws.items():
+            g = f["jaw_positions"][jaw]
+            assert np.array_equal(jm.rest_shape, g["rest/shape"][()]) and light.jaws[jaw].rest_shape is None
+            assert np.array_equal(jm.mandible, light.jaws[jaw].mandible)
+            for fam in ("single", "pair", "group"):
+                for name, net in getattr(jm, fam).items():
+                    n, other = g[fam][name], getattr(light.jaws[jaw], fam)[name]
+                    assert np.array_equal(net.shapes, n["shape"][()]) and net.shapes.dtype == np.float32
+                    assert other.shapes is None
+                    for a in (net, other):
+                        assert np.array_equal(a.x[..., 0, :], n["tip"][()]) and a.x.dtype == np.float64
+                        assert np.array_equal(a.converged, n["converged"][()]) and a.converged.dtype == bool
+                        assert np.array_equal(a.drift_cm, n["drift_cm"][()])
+                        assert all(np.array_equal(lv, n[f"force_{k}_n"][()]) for k, lv in enumerate(a.levels))
+
+
 def test_rerun_does_nothing_and_a_lost_file_comes_back_from_the_cache(small, mesh_file):
     tmp, cfg, _ = small
     again = build_ep_maps(mesh_file, cfg, tmp / "maps.h5", jobs=1, cache=tmp / "cache")
