@@ -104,6 +104,21 @@ def test_a_simulated_vowel_is_found_again_and_refined_within_its_tolerance(small
         assert (neutral[vector][:, 1] - rounded[vector][:, 1] > 50).all(), vector
 
 
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_held_out_random_force_sets_round_trip_through_their_formants(small_maps, mesh_file, seed):
+    """Forces off the maps' grid -> simulation -> formants -> solve -> forces -> simulation: within 3 %."""
+    tmp, cfg = small_maps
+    ggp, hg = np.random.default_rng(seed).uniform(0.3, 3.8, size=2)
+    voicer = simulator(mesh_file, cfg, voiced=True)
+    made = voicer.voice({}, {"GGp": float(ggp), "HG": float(hg)}, (3.0, 1.0), 0.0)
+    ctx = add_formants(load_context(tmp / "maps.h5", None, mesh_file), tmp / "maps.h5", mesh_file, cfg)
+    target = _acoustic(made["formants_hz"][:2], tol=3.0, name=f"held_out_{seed}")
+    doc, _, _ = solve_target(target, ctx, tmp / f"held_out_{seed}.yaml", voicer, refine=True, budget=6, config=cfg,
+                             mesh_sha256=voicer.mesh_sha256)
+    assert doc["refined"]["within_tolerance"], (ggp, hg, made["formants_hz"][:2], doc["refined"])
+    assert all(abs(e) <= 3.0 for e in doc["refined"]["errors_pct"][:2])
+
+
 def test_unreachable_formants_exit_3_with_the_nearest_and_write_it(small_maps, mesh_file, tmp_path):
     tmp, cfg = small_maps
     target = tmp_path / "far.yaml"
