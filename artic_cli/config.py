@@ -397,6 +397,9 @@ class VocalTract(Strict):
     upper_lip_cm: Outline
     lower_lip_cm: Outline  # with the mandible
     lips: LipControl = LipControl()
+    # other lip tubes whose formants the acoustic maps hold beside the default's (each costs about the default
+    # map's time again): a formant target with one of them is solved without computing its jaw position's EPs
+    mapped_lips: list[LipControl] = []
     lip_sections: Annotated[int, Field(ge=1, le=10)] = 2
     grid: TractGrid
     area_law_source: str = ""

@@ -16,7 +16,7 @@ import numpy as np
 from ..acoustics.tube import Tube
 from ..config import load_config
 from ..errors import ArticError
-from ..io.store import atomic_h5, open_artifact, stored_content_hash
+from ..io.store import atomic_h5, open_artifact, read_array, stored_content_hash
 from . import acoustics as acoustics_stage
 from . import epmap as epmap_stage
 from . import mesh as mesh_stage
@@ -45,10 +45,22 @@ class NetAcoustics:
 class AcousticMaps:
     jaws: dict[str, dict[str, NetAcoustics]]  # jaw -> "rest" | "single/SG" | "pair/SG+HG" ... -> acoustics
     attrs: dict = field(default_factory=dict)
+    # the config's other mapped lip tubes: (area cm^2, length cm) -> jaw -> net key -> formants (*grid, 4), Hz
+    lips: dict[tuple[float, float], dict[str, dict[str, np.ndarray]]] = field(default_factory=dict)
+
+    def formants_with(self, jaw: str, area_cm2: float, length_cm: float) -> dict[str, np.ndarray] | None:
+        """Every EP's formants at ``jaw`` with that lip tube, if the maps hold it (None otherwise)."""
+        held = self.lips.get(lip_key(area_cm2, length_cm))
+        return None if held is None or jaw not in held else held[jaw]
 
     def points(self, jaw: str) -> np.ndarray:
         """(P, 4) every EP's formants at a jaw position (the rest first)."""
         return np.concatenate([n.formants_hz.reshape(-1, FORMANTS) for n in self.jaws[jaw].values()])
+
+
+def lip_key(area_cm2: float, length_cm: float) -> tuple[float, float]:
+    """How a lip tube is looked up (cm^2, cm; rounded to 1e-6)."""
+    return round(float(area_cm2), 6), round(float(length_cm), 6)
 
 
 def net_acoustics(vt, cfg, mesh, model_rest: np.ndarray, mandible_nodes: np.ndarray, shapes: np.ndarray,
@@ -60,7 +72,8 @@ def net_acoustics(vt, cfg, mesh, model_rest: np.ndarray, mandible_nodes: np.ndar
     t = vt_stage.compute(vt, cfg.speaker.wall, sh, vt_stage.controls_for(vt, sh.time_s, overrides=overrides))
     tubes = [Tube(t.af.length_cm[k], t.af.area_cm2[k]) for k in range(t.n_frames)]
     ports = acoustics_stage.port_positions(t)
-    ac = acoustics_stage.compute(tubes, cfg, velum_area_cm2=t.controls["velum_port_cm2"], port_from_glottis_cm=ports)
+    ac = acoustics_stage.compute(tubes, cfg, velum_area_cm2=t.controls["velum_port_cm2"], port_from_glottis_cm=ports,
+                                 spectra=False)
     return NetAcoustics(formants_hz=ac.formants_hz[:, :FORMANTS].reshape(*grid, FORMANTS),
                         bandwidths_hz=ac.bandwidths_hz[:, :FORMANTS].reshape(*grid, FORMANTS),
                         area_cm2=t.af.area_cm2.reshape(*grid, -1), length_cm=t.af.length_cm.reshape(*grid, -1),
@@ -68,8 +81,9 @@ def net_acoustics(vt, cfg, mesh, model_rest: np.ndarray, mandible_nodes: np.ndar
 
 
 def compute(cfg, mesh, maps, progress: Callable[[int, int], None] | None = None, jaws: list[str] | None = None,
-            overrides: dict | None = None) -> AcousticMaps:
-    """Every EP's acoustics (``jaws``: those jaw positions only; ``overrides``: lip tube and port)."""
+            overrides: dict | None = None, mapped_lips: bool = False) -> AcousticMaps:
+    """Every EP's acoustics (``jaws``: those jaw positions only; ``overrides``: lip tube and port;
+    ``mapped_lips``: also the formants with each of ``vocal_tract.mapped_lips``, the config's port)."""
     vt = vt_stage.speaker_tract(cfg)
     if maps.model_rest is None or any(jm.rest_shape is None for jm in maps.jaws.values()):
         raise ArticError("the EP maps keep no shapes (an older artic built them); rerun 'artic ep-map'")
@@ -79,17 +93,24 @@ def compute(cfg, mesh, maps, progress: Callable[[int, int], None] | None = None,
         for fam in ("single", "pair", "group"):
             for name, net in getattr(jm, fam).items():
                 jobs.append((jname, f"{fam}/{name}", net.shapes))
+    tubes = [(float(lp.area_cm2), float(lp.length_cm)) for lp in vt.mapped_lips] if mapped_lips else []
     out: dict[str, dict[str, NetAcoustics]] = {j: {} for j in chosen}
-    total = sum(int(np.prod(s.shape[:-2])) for _, _, s in jobs)
-    done = 0
+    held: dict[tuple[float, float], dict[str, dict[str, np.ndarray]]] = {lip_key(*t): {j: {} for j in chosen}
+                                                                         for t in tubes}
+    per_set = sum(int(np.prod(s.shape[:-2])) for _, _, s in jobs)
+    total, done = per_set * (1 + len(held)), 0
     for jname, key, shapes in jobs:
         if progress is not None:
             progress(done, total)
         out[jname][key] = net_acoustics(vt, cfg, mesh, maps.model_rest, maps.mandible_nodes, shapes, overrides)
-        done += int(np.prod(shapes.shape[:-2]))
+        for area, length in tubes:
+            lips = {"lip_area_cm2": area, "lip_length_cm": length, "velum_port_cm2": float(vt.velum_port_cm2)}
+            held[lip_key(area, length)][jname][key] = net_acoustics(
+                vt, cfg, mesh, maps.model_rest, maps.mandible_nodes, shapes, lips).formants_hz
+        done += int(np.prod(shapes.shape[:-2])) * (1 + len(held))
     if progress is not None:
         progress(total, total)
-    return AcousticMaps(jaws=out)
+    return AcousticMaps(jaws=out, lips=held)
 
 
 def write(path: Path | str, result: AcousticMaps, prov=None) -> None:
@@ -98,6 +119,14 @@ def write(path: Path | str, result: AcousticMaps, prov=None) -> None:
                              "bandwidths_hz (*grid x 4), area_cm2, length_cm (*grid x sections, glottis first), "
                              "min_area_cm2}: the grids of the EP maps' nets")
         f.attrs["jaw_order"] = list(result.jaws)
+        f.attrs["lips_layout"] = ("lips/<k>/<jaw>/<net key>/formants_hz: the formants with lip tube k (its attrs: "
+                                  "area_cm2, length_cm; the config's port)")
+        for k, ((area, length), jaws) in enumerate(result.lips.items()):
+            lg = f.create_group(f"lips/{k}")
+            lg.attrs["area_cm2"], lg.attrs["length_cm"] = area, length
+            for jname, nets in jaws.items():
+                for key, fm in nets.items():
+                    lg.create_dataset(f"{jname}/{key}/formants_hz", data=fm).attrs["units"] = "Hz"
         for jname, nets in result.jaws.items():
             g = f.create_group(f"jaw_positions/{jname}")
             g.attrs["order"] = list(nets)
@@ -109,15 +138,28 @@ def write(path: Path | str, result: AcousticMaps, prov=None) -> None:
                     h.create_dataset(name, data=data, compression="gzip").attrs["units"] = unit
 
 
-def read(path: Path | str) -> AcousticMaps:
+def read(path: Path | str, formants_only: bool = False) -> AcousticMaps:
+    """The acoustic maps; ``formants_only``: each EP's formants, the rest of a net's record left empty (what
+    a formant target is solved on, in a fifth of the time)."""
+    keep = ("formants_hz",) if formants_only else ("formants_hz", "bandwidths_hz", "area_cm2", "length_cm",
+                                                   "min_area_cm2")
+    empty = np.zeros(0)
     with open_artifact(path, STAGE.kind, STAGE.hint) as f:
         try:
             jaws = {}
             for jname in f.attrs["jaw_order"]:
                 g = f["jaw_positions"][jname]
-                jaws[str(jname)] = {str(k): NetAcoustics(**{d: g[k][d][()] for d in (
-                    "formants_hz", "bandwidths_hz", "area_cm2", "length_cm", "min_area_cm2")}) for k in g.attrs["order"]}
-            return AcousticMaps(jaws=jaws, attrs={k: v for k, v in f.attrs.items()})
+                jaws[str(jname)] = {}
+                for k in g.attrs["order"]:
+                    h = g[k]
+                    got = {d: read_array(h, d) if d in keep else empty for d in (
+                        "formants_hz", "bandwidths_hz", "area_cm2", "length_cm", "min_area_cm2")}
+                    jaws[str(jname)][str(k)] = NetAcoustics(**got)
+            lips = {}
+            for lg in (f["lips"].values() if "lips" in f else ()):
+                lips[lip_key(lg.attrs["area_cm2"], lg.attrs["length_cm"])] = {
+                    str(j): {k: read_array(lg, f"{j}/{k}/formants_hz") for k in jaws[str(j)]} for j in lg}
+            return AcousticMaps(jaws=jaws, attrs={k: v for k, v in f.attrs.items()}, lips=lips)
         except (KeyError, ValueError, OSError, TypeError) as err:
             raise ArticError(f"{path} is damaged or incomplete ({type(err).__name__}); {STAGE.hint}") from None
 
@@ -140,6 +182,6 @@ def acoustic_map(maps: Path | str = "data/epmaps.h5", mesh: Path | str = "data/m
     prov = STAGE.provenance(cfg, inputs={"mesh": m.content_sha256, "epmaps": str(stored_content_hash(maps))})
     if not force and up_to_date(out, prov):
         return AcousticMapResult(out, read(out), up_to_date=True)
-    result = compute(cfg, m.mesh, ep, progress)
+    result = compute(cfg, m.mesh, ep, progress, mapped_lips=True)
     write(out, result, prov)
     return AcousticMapResult(out, result)

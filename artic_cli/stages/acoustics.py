@@ -38,9 +38,11 @@ class Acoustics:
 
 
 def compute(tubes: list[Tube], cfg: Config, lossless: bool = False, velum_area_cm2=None,
-            port_from_glottis_cm=None, progress=None) -> Acoustics:
+            port_from_glottis_cm=None, progress=None, spectra: bool = True) -> Acoustics:
     """Every tube's acoustics; ``velum_area_cm2`` and ``port_from_glottis_cm``: one value for all tubes or one
-    per tube (None: the config's port area, and its distance from the lips for a plain tube)."""
+    per tube (None: the config's port area, and its distance from the lips for a plain tube).  ``spectra=False``:
+    formants and bandwidths only (the stored transfer function and pressure spectrum are half the work; their
+    arrays are then empty)."""
     ac = STAGE.view(cfg).acoustics
     air = air_of(ac, lossless)
     f = frequencies(ac)
@@ -52,15 +54,19 @@ def compute(tubes: list[Tube], cfg: Config, lossless: bool = False, velum_area_c
         velum, port = per(velum_area_cm2, k), per(port_from_glottis_cm, k)
         tract = tract_of(tube, ac, None if velum is None else float(velum), lossless,
                          None if port is None else float(port))
-        h = transfer(tract, f, air)
-        tf.append(20 * np.log10(np.maximum(np.abs(h), 1e-12)))
-        pr.append(20 * np.log10(np.maximum(np.abs(radiated_pressure(h, f, air)), 1e-30) / 2e-4))
+        if spectra:
+            h = transfer(tract, f, air)
+            tf.append(20 * np.log10(np.maximum(np.abs(h), 1e-12)))
+            pr.append(20 * np.log10(np.maximum(np.abs(radiated_pressure(h, f, air)), 1e-30) / 2e-4))
         fk, bk = formants(lambda x, t=tract: np.abs(transfer(t, x, air)), ac.max_frequency_hz,
                           ac.formant_search_step_hz, ac.formants, lossless=lossless)
         fm.append(fk)
         bw.append(bk)
     if progress is not None:
         progress(len(tubes), len(tubes))
+    if not spectra:
+        f = np.zeros(0)
+        tf = pr = np.zeros((len(tubes), 0))
     return Acoustics(f, np.array(tf), np.array(pr), np.array(fm), np.array(bw),
                      min_area_cm2=np.array([float(np.min(t.area_cm2)) for t in tubes]))
 

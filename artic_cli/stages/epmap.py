@@ -15,7 +15,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
 
-import h5py
 import numpy as np
 
 from ..config import Config, load_config
@@ -24,7 +23,7 @@ from ..control.epmap import (CONTROL_POINTS, EPMaps, JawMaps, Net, assemble, can
 from ..control.equilibrium import compute_ep, compute_rest, spec_key
 from ..errors import ArticError
 from ..io.fingerprint import code_hash, digest, sections_hash
-from ..io.store import atomic_h5, open_artifact
+from ..io.store import atomic_h5, open_artifact, read_array
 from ..mechanics.model import ARTICULATOR_SECTIONS
 from ..parallel import Sweep, run_sweep
 from ..validation import check_number
@@ -156,16 +155,6 @@ def write(path: Path | str, maps: EPMaps, cfg: Config, prov=None, fast: bool = F
                         f"cm moved over the last {cfg.epmap.convergence_window_ms:g} ms")
 
 
-def _array(group, name: str) -> np.ndarray:
-    """A whole dataset of ``group``, read through h5py's low-level API: the maps hold about a thousand small
-    datasets, and the high-level one spends most of a load on each one's Python wrapper (0.3 s -> 0.1 s)."""
-    d = h5py.h5d.open(group.id, name.encode())
-    out = np.empty(d.shape, dtype=d.dtype)
-    if out.size:
-        d.read(h5py.h5s.ALL, h5py.h5s.ALL, out)
-    return out[()] if out.ndim == 0 else out
-
-
 def read(path: Path | str = "data/epmaps.h5", mesh: Path | str | None = None, shapes: bool = True) -> EPMaps:
     """Maps written by :func:`build_ep_maps` (``attrs`` holds the root attributes, ``content_sha256`` among
     them); with ``mesh``, checks they were built from that mesh's content.  ``shapes=False`` leaves the EPs'
@@ -182,19 +171,19 @@ def read(path: Path | str = "data/epmaps.h5", mesh: Path | str | None = None, sh
             for jname in f.attrs["jaw_order"]:
                 g = f["jaw_positions"][jname]
                 r = g["rest"]
-                rest = np.array([_array(r, cp) for cp in CONTROL_POINTS])
+                rest = np.array([read_array(r, cp) for cp in CONTROL_POINTS])
                 jm = JawMaps(forces=json.loads(g.attrs["jaw_forces_n"]), rest=rest, single={},
-                             mandible=_array(r, "mandible") if "mandible" in r else None,
-                             rest_shape=_array(r, "shape") if shapes and "shape" in r else None)
+                             mandible=read_array(r, "mandible") if "mandible" in r else None,
+                             rest_shape=read_array(r, "shape") if shapes and "shape" in r else None)
                 for fam in ("single", "pair", "group"):
                     for name in g.attrs[f"{fam}_order"]:
                         n = g[fam][name]
                         muscles = tuple(n.attrs["muscles"])
-                        levels = tuple(_array(n, f"force_{k}_n") for k in range(len(muscles)))
-                        x = np.stack([_array(n, cp) for cp in CONTROL_POINTS], axis=-2)
+                        levels = tuple(read_array(n, f"force_{k}_n") for k in range(len(muscles)))
+                        x = np.stack([read_array(n, cp) for cp in CONTROL_POINTS], axis=-2)
                         getattr(jm, fam)[name] = Net(muscles=muscles, levels=levels, x=x,
-                                                     converged=_array(n, "converged"), drift_cm=_array(n, "drift_cm"),
-                                                     shapes=_array(n, "shape") if shapes and "shape" in n else None)
+                                                     converged=read_array(n, "converged"), drift_cm=read_array(n, "drift_cm"),
+                                                     shapes=read_array(n, "shape") if shapes and "shape" in n else None)
                 jaws[jname] = jm
             attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()}
             return EPMaps(jaws=jaws, typical_jaw=str(f.attrs["typical_jaw"]), attrs=attrs,

@@ -119,6 +119,26 @@ def test_held_out_random_force_sets_round_trip_through_their_formants(small_maps
     assert all(abs(e) <= 3.0 for e in doc["refined"]["errors_pct"][:2])
 
 
+def test_the_acoustic_maps_hold_the_mapped_lip_tubes_formants_as_computed(small_maps, mesh_file, tmp_path):
+    """The config's mapped lip tubes (the default speaker's four vowel lips) are looked up in the acoustic maps,
+    equal to what a formant target computes without them; other lips are still computed."""
+    from artic_cli.stages.acoustic_map import acoustic_map, read
+
+    tmp, cfg = small_maps
+    acoustic_map(tmp / "maps.h5", mesh_file, cfg, tmp_path / "am.h5")
+    held = read(tmp_path / "am.h5", formants_only=True)
+    assert set(held.lips) == {(4.0, 0.5), (2.5, 0.55), (1.0, 1.2), (0.37, 1.9)}
+    with_maps = add_formants(load_context(tmp / "maps.h5", None, mesh_file), tmp / "maps.h5", mesh_file, cfg,
+                             tmp_path / "am.h5")
+    computed = add_formants(load_context(tmp / "maps.h5", None, mesh_file), tmp / "maps.h5", mesh_file, cfg)
+    for lips in ((2.5, 0.55), (0.37, 1.9), (0.6, 1.5)):
+        a, b = with_maps.formants("rest", *lips, 0.0), computed.formants("rest", *lips, 0.0)
+        assert set(a) == set(b) and len(a) == 5
+        for key in a:
+            np.testing.assert_array_equal(a[key], b[key])
+    assert held.formants_with("rest", 0.6, 1.5) is None and held.formants_with("JO_6", 2.5, 0.55) is None
+
+
 def test_unreachable_formants_exit_3_with_the_nearest_and_write_it(small_maps, mesh_file, tmp_path):
     tmp, cfg = small_maps
     target = tmp_path / "far.yaml"
