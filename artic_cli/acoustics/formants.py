@@ -79,10 +79,12 @@ def _crossing(magnitude, lo: np.ndarray, hi: np.ndarray, level: np.ndarray) -> n
 
 
 def formants(magnitude: Callable[[np.ndarray], np.ndarray], f_max_hz: float = 5500.0, step_hz: float = 5.0,
-             count: int = 5, f_min_hz: float = 50.0, lossless: bool = False) -> tuple[np.ndarray, np.ndarray]:
+             count: int = 5, f_min_hz: float = 50.0, lossless: bool = False,
+             bandwidths: bool = True) -> tuple[np.ndarray, np.ndarray]:
     """The first ``count`` formants (Hz, ascending) and their -3 dB bandwidths (Hz); NaN where there are
     fewer peaks below ``f_max_hz``.  ``lossless``: the peaks are poles on the real axis (bandwidth 0), only
-    their frequencies are refined."""
+    their frequencies are refined.  ``bandwidths=False``: the frequencies only (bandwidths NaN; a third less
+    work)."""
     f = np.arange(f_min_hz, f_max_hz + step_hz, step_hz)
     m = magnitude(f)
     db = 20 * np.log10(np.maximum(m, 1e-300))
@@ -98,6 +100,9 @@ def formants(magnitude: Callable[[np.ndarray], np.ndarray], f_max_hz: float = 55
     if lossless:
         freq[: len(peaks)] = fp
         bw[: len(peaks)] = 0.0
+        return freq, bw
+    if not bandwidths:
+        freq[: len(peaks)] = fp
         return freq, bw
     half = top / np.sqrt(2.0)
     left = np.empty(len(peaks))

@@ -431,11 +431,14 @@ def acoustic_map_cmd(
     out: Path = typer.Option(Path("data/acoustic_maps.h5"), "--out", help="Formants and area functions (HDF5)."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="The vowel space: every EP in the F1-F2 plane (PNG)."),
     force: bool = typer.Option(False, "--force", help="Recompute even if the file is up to date."),
+    jobs: int = typer.Option(2, "--jobs", help="Parallel workers (net by net)."),
 ):
-    """Every EP's area function and formants F1-F4: the EP maps made acoustic."""
+    """Every EP's area function and formants F1-F4 (with the config's lips and its mapped lip tubes): the EP
+    maps made acoustic."""
     from ..stages.acoustic_map import JAPANESE_VOWELS, acoustic_map
 
-    r = _with_progress("EPs", lambda update: acoustic_map(maps, mesh, config, out, update, force))
+    check_number("--jobs", jobs, ge=1)
+    r = _with_progress("nets", lambda update: acoustic_map(maps, mesh, config, out, update, force, jobs))
     rows = []
     for jname in r.maps.jaws:
         p = r.maps.points(jname)

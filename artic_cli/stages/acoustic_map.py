@@ -17,6 +17,7 @@ from ..acoustics.tube import Tube
 from ..config import load_config
 from ..errors import ArticError
 from ..io.store import atomic_h5, open_artifact, read_array, stored_content_hash
+from ..parallel import Sweep, run_sweep
 from . import acoustics as acoustics_stage
 from . import epmap as epmap_stage
 from . import mesh as mesh_stage
@@ -64,8 +65,9 @@ def lip_key(area_cm2: float, length_cm: float) -> tuple[float, float]:
 
 
 def net_acoustics(vt, cfg, mesh, model_rest: np.ndarray, mandible_nodes: np.ndarray, shapes: np.ndarray,
-                  overrides: dict | None = None) -> NetAcoustics:
-    """Tracts and formants of a grid of shapes (*grid, N, 3); ``overrides``: lip tube and port controls."""
+                  overrides: dict | None = None, bandwidths: bool = True) -> NetAcoustics:
+    """Tracts and formants of a grid of shapes (*grid, N, 3); ``overrides``: lip tube and port controls;
+    ``bandwidths=False``: NaN bandwidths (the formants in two thirds of the time)."""
     grid = shapes.shape[:-2]
     flat = shapes.reshape(-1, *shapes.shape[-2:]).astype(float)
     sh = vt_stage.shapes_of(flat, np.zeros(len(flat)), mesh, model_rest, mandible_nodes)
@@ -73,43 +75,61 @@ def net_acoustics(vt, cfg, mesh, model_rest: np.ndarray, mandible_nodes: np.ndar
     tubes = [Tube(t.af.length_cm[k], t.af.area_cm2[k]) for k in range(t.n_frames)]
     ports = acoustics_stage.port_positions(t)
     ac = acoustics_stage.compute(tubes, cfg, velum_area_cm2=t.controls["velum_port_cm2"], port_from_glottis_cm=ports,
-                                 spectra=False)
+                                 spectra=False, bandwidths=bandwidths)
     return NetAcoustics(formants_hz=ac.formants_hz[:, :FORMANTS].reshape(*grid, FORMANTS),
                         bandwidths_hz=ac.bandwidths_hz[:, :FORMANTS].reshape(*grid, FORMANTS),
                         area_cm2=t.af.area_cm2.reshape(*grid, -1), length_cm=t.af.length_cm.reshape(*grid, -1),
                         min_area_cm2=t.af.area_cm2.min(axis=1).reshape(grid))
 
 
+def _net_task(cfg, mesh, model_rest: np.ndarray, mandible_nodes: np.ndarray, shapes: np.ndarray,
+              settings: list[dict | None], bandwidths: bool = True) -> list[NetAcoustics]:
+    """One net's acoustics with each lip and port setting (one task: its shapes travel once); bandwidths with
+    the first setting only (the mapped lip tubes keep their formants)."""
+    vt = vt_stage.speaker_tract(cfg)
+    return [net_acoustics(vt, cfg, mesh, model_rest, mandible_nodes, shapes, over, bandwidths=bandwidths and k == 0)
+            for k, over in enumerate(settings)]
+
+
 def compute(cfg, mesh, maps, progress: Callable[[int, int], None] | None = None, jaws: list[str] | None = None,
-            overrides: dict | None = None, mapped_lips: bool = False) -> AcousticMaps:
+            overrides: dict | None = None, mapped_lips: bool = False, jobs: int = 1,
+            bandwidths: bool = True) -> AcousticMaps:
     """Every EP's acoustics (``jaws``: those jaw positions only; ``overrides``: lip tube and port;
-    ``mapped_lips``: also the formants with each of ``vocal_tract.mapped_lips``, the config's port)."""
+    ``mapped_lips``: also the formants with each of ``vocal_tract.mapped_lips``, the config's port), net by
+    net on ``jobs`` workers (``progress``: nets done); ``bandwidths=False``: formants only."""
     vt = vt_stage.speaker_tract(cfg)
     if maps.model_rest is None or any(jm.rest_shape is None for jm in maps.jaws.values()):
         raise ArticError("the EP maps keep no shapes (an older artic built them); rerun 'artic ep-map'")
     chosen = {j: jm for j, jm in maps.jaws.items() if jaws is None or j in jaws}
-    jobs = [(jname, "rest", jm.rest_shape[None]) for jname, jm in chosen.items()]
+    nets = [(jname, "rest", jm.rest_shape[None]) for jname, jm in chosen.items()]
     for jname, jm in chosen.items():
         for fam in ("single", "pair", "group"):
             for name, net in getattr(jm, fam).items():
-                jobs.append((jname, f"{fam}/{name}", net.shapes))
-    tubes = [(float(lp.area_cm2), float(lp.length_cm)) for lp in vt.mapped_lips] if mapped_lips else []
-    out: dict[str, dict[str, NetAcoustics]] = {j: {} for j in chosen}
-    held: dict[tuple[float, float], dict[str, dict[str, np.ndarray]]] = {lip_key(*t): {j: {} for j in chosen}
-                                                                         for t in tubes}
-    per_set = sum(int(np.prod(s.shape[:-2])) for _, _, s in jobs)
-    total, done = per_set * (1 + len(held)), 0
-    for jname, key, shapes in jobs:
+                nets.append((jname, f"{fam}/{name}", net.shapes))
+    settings = [(None, overrides)] + [
+        (lip_key(lp.area_cm2, lp.length_cm), {"lip_area_cm2": float(lp.area_cm2), "lip_length_cm": float(lp.length_cm),
+                                              "velum_port_cm2": float(vt.velum_port_cm2)})
+        for lp in (vt.mapped_lips if mapped_lips else [])]
+    overs = [over for _, over in settings]
+    calls = [(cfg, mesh, maps.model_rest, maps.mandible_nodes, shapes, overs, bandwidths) for _, _, shapes in nets]
+    if jobs > 1:
+        done = run_sweep(_net_task, calls, Sweep(jobs=jobs, progress=progress)).results
+    else:
+        done = []
+        for k, call in enumerate(calls):
+            if progress is not None:
+                progress(k, len(calls))
+            done.append(_net_task(*call))
         if progress is not None:
-            progress(done, total)
-        out[jname][key] = net_acoustics(vt, cfg, mesh, maps.model_rest, maps.mandible_nodes, shapes, overrides)
-        for area, length in tubes:
-            lips = {"lip_area_cm2": area, "lip_length_cm": length, "velum_port_cm2": float(vt.velum_port_cm2)}
-            held[lip_key(area, length)][jname][key] = net_acoustics(
-                vt, cfg, mesh, maps.model_rest, maps.mandible_nodes, shapes, lips).formants_hz
-        done += int(np.prod(shapes.shape[:-2])) * (1 + len(held))
-    if progress is not None:
-        progress(total, total)
+            progress(len(calls), len(calls))
+    out: dict[str, dict[str, NetAcoustics]] = {j: {} for j in chosen}
+    held: dict[tuple[float, float], dict[str, dict[str, np.ndarray]]] = {}
+    for (jname, key, _), results in zip(nets, done):
+        for (lips, _), res in zip(settings, results):
+            if lips is None:
+                out[jname][key] = res
+            else:
+                held.setdefault(lips, {j: {} for j in chosen})[jname][key] = res.formants_hz
     return AcousticMaps(jaws=out, lips=held)
 
 
@@ -173,8 +193,9 @@ class AcousticMapResult:
 
 def acoustic_map(maps: Path | str = "data/epmaps.h5", mesh: Path | str = "data/mesh.h5",
                  config: Path | str | None = None, out: Path | str = "data/acoustic_maps.h5",
-                 progress: Callable[[int, int], None] | None = None, force: bool = False) -> AcousticMapResult:
-    """The formants of every EP of the maps (left alone when ``out`` holds this recipe)."""
+                 progress: Callable[[int, int], None] | None = None, force: bool = False,
+                 jobs: int = 2) -> AcousticMapResult:
+    """The formants of every EP of the maps (left alone when ``out`` holds this recipe), on ``jobs`` workers."""
     cfg = load_config(config)
     m = mesh_stage.read(mesh, cfg)
     ep = epmap_stage.read(maps, mesh)
@@ -182,6 +203,6 @@ def acoustic_map(maps: Path | str = "data/epmaps.h5", mesh: Path | str = "data/m
     prov = STAGE.provenance(cfg, inputs={"mesh": m.content_sha256, "epmaps": str(stored_content_hash(maps))})
     if not force and up_to_date(out, prov):
         return AcousticMapResult(out, read(out), up_to_date=True)
-    result = compute(cfg, m.mesh, ep, progress, mapped_lips=True)
+    result = compute(cfg, m.mesh, ep, progress, mapped_lips=True, jobs=jobs)
     write(out, result, prov)
     return AcousticMapResult(out, result)

@@ -38,11 +38,11 @@ class Acoustics:
 
 
 def compute(tubes: list[Tube], cfg: Config, lossless: bool = False, velum_area_cm2=None,
-            port_from_glottis_cm=None, progress=None, spectra: bool = True) -> Acoustics:
+            port_from_glottis_cm=None, progress=None, spectra: bool = True, bandwidths: bool = True) -> Acoustics:
     """Every tube's acoustics; ``velum_area_cm2`` and ``port_from_glottis_cm``: one value for all tubes or one
     per tube (None: the config's port area, and its distance from the lips for a plain tube).  ``spectra=False``:
     formants and bandwidths only (the stored transfer function and pressure spectrum are half the work; their
-    arrays are then empty)."""
+    arrays are then empty); ``bandwidths=False``: NaN bandwidths (a third of the formant search)."""
     ac = STAGE.view(cfg).acoustics
     air = air_of(ac, lossless)
     f = frequencies(ac)
@@ -59,7 +59,7 @@ def compute(tubes: list[Tube], cfg: Config, lossless: bool = False, velum_area_c
             tf.append(20 * np.log10(np.maximum(np.abs(h), 1e-12)))
             pr.append(20 * np.log10(np.maximum(np.abs(radiated_pressure(h, f, air)), 1e-30) / 2e-4))
         fk, bk = formants(lambda x, t=tract: np.abs(transfer(t, x, air)), ac.max_frequency_hz,
-                          ac.formant_search_step_hz, ac.formants, lossless=lossless)
+                          ac.formant_search_step_hz, ac.formants, lossless=lossless, bandwidths=bandwidths)
         fm.append(fk)
         bw.append(bk)
     if progress is not None:

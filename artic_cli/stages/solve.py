@@ -75,7 +75,7 @@ def add_formants(ctx: Context, maps: Path | str, mesh: Path | str, config: Path 
                 if not whole:
                     whole.append(epmap_stage.read(maps))
                 nets = am_stage.compute(cfg, m.mesh, whole[0], jaws=[jaw], overrides={
-                    "lip_area_cm2": area, "lip_length_cm": length, "velum_port_cm2": port}).jaws[jaw]
+                    "lip_area_cm2": area, "lip_length_cm": length, "velum_port_cm2": port}, bandwidths=False).jaws[jaw]
                 cache[key] = {k: n.formants_hz for k, n in nets.items()}
         return cache[key]
 

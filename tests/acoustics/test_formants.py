@@ -45,3 +45,23 @@ def test_computing_formants_does_not_import_scipy_signal():
             "assert abs(r.formants_hz[0][0] - 500) < 30, r.formants_hz[0]; print('scipy.signal' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.strip() == "False"
+
+
+def test_formants_without_bandwidths_are_the_same_frequencies():
+    from artic_cli.acoustics.chain import Air
+    from artic_cli.acoustics.formants import formants
+    from artic_cli.acoustics.transfer import transfer
+    from artic_cli.acoustics.tube import Tube
+    from artic_cli.config import load_config
+    from artic_cli.stages.acoustics import tract_of
+
+    ac = load_config().acoustics
+    rng = np.random.default_rng(7)
+    for _ in range(5):
+        tube = Tube(np.full(40, 0.43), rng.uniform(0.3, 5.0, 40))
+        tract = tract_of(tube, ac, None, False, None)
+        mag = lambda f, t=tract: np.abs(transfer(t, f, Air()))  # noqa: E731
+        full = formants(mag, ac.max_frequency_hz, ac.formant_search_step_hz, ac.formants)
+        lean = formants(mag, ac.max_frequency_hz, ac.formant_search_step_hz, ac.formants, bandwidths=False)
+        np.testing.assert_array_equal(lean[0], full[0])
+        assert np.isnan(lean[1]).all() and np.isfinite(full[1][np.isfinite(full[0])]).all()
