@@ -25,7 +25,7 @@ for the dashpot only; it stays dissipative: power = c (n . dv)^2 >= 0).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cached_property, lru_cache
 
 import numpy as np
 
@@ -158,9 +158,14 @@ def axial_forces(cyl: CylinderSet, cs: CylinderState, frame: DampingFrame | None
     return f
 
 
+@lru_cache(maxsize=4)
+def _gauss_legendre(points: int) -> tuple[np.ndarray, np.ndarray]:
+    return np.polynomial.legendre.leggauss(points)
+
+
 def strain_energy(cyl: CylinderSet, strain: np.ndarray, points: int = 8) -> np.ndarray:
     """Elastic energy stored in each cylinder, erg (Gauss-Legendre in strain)."""
-    s, w = np.polynomial.legendre.leggauss(points)
+    s, w = _gauss_legendre(points)
     e = 0.5 * (s[:, None] + 1.0) * strain[None, :]  # (P,C)
     shrink = np.maximum(1.0 - cyl.poisson * e, 0.05)
     over = np.maximum(e - cyl.knee, 0.0)

@@ -175,6 +175,7 @@ class State:
     v: np.ndarray  # (N,3) cm/s
     history: tuple[np.ndarray, ...] = ()  # previous positions, newest first
     history_dt: float = 0.0
+    history_passed: bool = False  # every position in history is one the body passed through (none made up at a start)
     sigma2: np.ndarray | None = None  # (F,) Maxwell stress of each fibre, dyn/cm^2
     fibre_strain: np.ndarray | None = None  # (F,)
     factor: BandFactor | None = None  # scratch: reused factorisation

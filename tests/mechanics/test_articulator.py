@@ -92,6 +92,16 @@ def test_a_strong_muscle_keeps_volume_and_stays_inside_the_wall(art, rest):
         assert wall_query(art.contact, x)[2].max() <= art.contact.tolerance + 1e-12
 
 
+def test_a_sudden_load_from_rest_costs_few_newton_iterations(art, rest):
+    """SG 4 N + JO 3 N switched on at rest: the second step starts from a linear guess (the quadratic one
+    doubles the first step's move), and an update that raises the residual is halved.  Each of the first
+    two steps took 24 iterations before."""
+    ctl = Control(node_force=np.zeros((art.n_nodes, 3)), muscle_force=muscle_force_vector(art, {"SG": 4.0, "JO": 3.0}))
+    traj, _ = run(art, rest, lambda t: ctl, 0.015)
+    assert traj.stats["steps"] == 3
+    assert traj.iterations[1:3].max() <= 12, traj.iterations
+
+
 def test_schedule_muscles_are_checked(art):
     s = parse_schedule({"muscles": [{"muscle": "GGz", "force_n": 1, "duration_ms": 10}]})
     with pytest.raises(ArticError, match="unknown; valid: GGa, GGm"):
