@@ -4,7 +4,7 @@ Each wall part (palate with velum, posterior pharyngeal wall, lingual
 surface of the mandibular symphysis) is given as an outline per sagittal
 slice at z >= 0; slices are mirrored to -z, every outline is resampled to the
 same number of points by arc length, and neighbouring slices are joined by
-triangle strips.  Normals are unit vectors pointing *out of the lumen* (into
+triangle strips whose diagonals mirror each other across z = 0.  Normals are unit vectors pointing *out of the lumen* (into
 the wall): a tongue point p is beyond a triangle when (p - q) . n > 0.
 """
 
@@ -52,7 +52,11 @@ def wall_surface(geo: WallGeometry) -> WallSurface:
         nz = grid.shape[0]
         ids = np.arange(nz * n).reshape(nz, n) + offset
         a, b, c, d = ids[:-1, :-1], ids[:-1, 1:], ids[1:, 1:], ids[1:, :-1]
-        t = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3), np.stack([a, c, d], -1).reshape(-1, 3)])
+        # each quad is split along a-c on the +z side and along b-d on the -z side, so that the left half's
+        # triangles are the mirror images of the right half's (the body is solved by halves)
+        left = (np.asarray(zs[:-1]) < 0)[:, None]
+        t = np.concatenate([np.stack([a, b, np.where(left, d, c)], -1).reshape(-1, 3),
+                            np.stack([np.where(left, b, a), c, d], -1).reshape(-1, 3)])
         v = grid.reshape(-1, 3)
         nrm = triangle_normals(np.concatenate(verts + [v]) if verts else v, t)
         centre = (np.concatenate(verts + [v]) if verts else v)[t].mean(axis=1)

@@ -93,15 +93,27 @@ def test_a_simulated_vowel_is_found_again_and_refined_within_its_tolerance(small
     assert len(af["length_cm"]) == len(af["area_cm2"]) and 14.0 < sum(af["length_cm"]) < 22.0
     assert doc["lips"] == {"area_cm2": 3.0, "length_cm": 1.0}
     # rounded lips lengthen and narrow the lip tube at the radiating end, where every mode's volume velocity
-    # peaks: every EP's F1-F3 fall, the formant of the cavity in front of the tongue's constriction by 50 Hz
-    # or more (F2 with the tongue back, SG and HG; F3 with it fronted, GGp, whose F2 is the back cavity's)
+    # peaks: no formant rises, and while the tract is open every EP's F1-F3 fall, the formant of the cavity in
+    # front of the tongue's constriction by 50 Hz or more (F2 with the tongue back, SG and HG; F3 with it
+    # fronted, GGp, whose F2 is the back cavity's).  Where SG closes the velar tract (2.5 and 4 N: the dorsum
+    # on the palate) the cavities decouple: the front one's resonance is F1 and falls, the back one's stay.
+    from artic_cli.config import load_config
+    from artic_cli.stages import acoustic_map as am_stage, epmap as epmap_stage, mesh as mesh_stage
+
+    c = load_config(cfg)
+    nets = am_stage.compute(c, mesh_stage.read(mesh_file, c).mesh, epmap_stage.read(tmp / "maps.h5"), jaws=["rest"],
+                            bandwidths=False).jaws["rest"]
     neutral, rounded = ctx.formants("rest", 3.0, 1.0, 0.0), ctx.formants("rest", 0.6, 1.5, 0.0)
     for vector in ("single/GGp", "single/SG", "single/HG"):
         fall = neutral[vector][:, :3] - rounded[vector][:, :3]
-        assert (fall > 0).all(), (vector, fall)
-    assert (neutral["single/GGp"][:, 2] - rounded["single/GGp"][:, 2] > 50).all()
-    for vector in ("single/SG", "single/HG"):
-        assert (neutral[vector][:, 1] - rounded[vector][:, 1] > 50).all(), vector
+        is_open = nets[vector].min_area_cm2 > 0.05
+        assert (fall > -1.0).all(), (vector, fall)  # the back cavity's, behind a closure: within 1 Hz
+        assert (fall[is_open] > 0).all(), (vector, fall)
+        front = 2 if vector == "single/GGp" else 1
+        assert (fall[is_open, front] > 50).all(), (vector, fall)
+        assert (fall[~is_open, 0] > 50).all(), (vector, fall)
+        assert is_open.sum() >= 2, vector
+    assert (~(nets["single/SG"].min_area_cm2 > 0.05)).any()  # SG does close the tract
 
 
 @pytest.mark.parametrize("seed", [1, 2, 3])

@@ -21,6 +21,13 @@ def test_wall_is_symmetric(wall):
     # every vertex has its mirror image among the vertices
     d = np.linalg.norm(wall.vertices[:, None, :] - mirrored[None, :, :], axis=2).min(axis=1)
     assert d.max() < 1e-12
+    # and every triangle its mirror image among the triangles (the quads' diagonals mirror each other), with
+    # the mirrored normal: the contact forces on a symmetric body are symmetric
+    image = np.abs(wall.vertices[:, None, :] - mirrored[None, :, :]).sum(axis=2).argmin(axis=1)
+    tris = {tuple(sorted(t)): k for k, t in enumerate(wall.triangles.tolist())}
+    twins = [tris.get(tuple(sorted(image[t]))) for t in wall.triangles]
+    assert None not in twins
+    assert np.allclose(wall.normals[twins], wall.normals * [1, 1, -1])
 
 
 def test_rest_tongue_surface_lies_below_the_palate(mesh, wall):

@@ -201,16 +201,11 @@ def test_every_definite_direction_is_tested():
     assert listed == set(AGREE) | set(KNOWN)
 
 
-def test_sg_brings_the_dorsum_onto_the_palate(art, cfg):
-    """SG alone, jaw held at rest as the maps hold it: no contact at 0.5 N, the dorsum region on the wall by 4 N."""
-    row = k_closure(art, forces=(0.5, 4.0), hold=cfg.epmap.hold_jaw, reach=False)[0]
-    assert row.ours == 4.0, row.note
-
-
-@pytest.mark.xfail(strict=True, reason="known difference (issue 15 open): SG's first dorsum contact comes between 3 "
-                                       "and 4 N (the paper: about 1 N; the issue's goal 0.5-2 N)")
-def test_sg_reaches_the_palate_by_2_n(art, cfg):
-    assert k_closure(art, forces=(2.0,), hold=cfg.epmap.hold_jaw, reach=False)[0].ours == 2.0
+def test_sg_first_brings_the_dorsum_onto_the_palate_between_0_5_and_2_n(art, cfg):
+    """SG alone, jaw held at rest as the maps hold it: no contact at 0.5 N, the dorsum region on the wall by 2 N
+    (the paper: about 1 N; ours 1.5 N with the default speaker's palate, 4 N with anatomy.md's)."""
+    row = k_closure(art, forces=(0.5, 1.0, 1.5, 2.0), hold=cfg.epmap.hold_jaw, reach=False)[0]
+    assert row.ours in (1.0, 1.5, 2.0), row.note
 
 
 def _touching(art, rest, forces, part):

@@ -59,8 +59,8 @@ def test_the_half_moves_as_the_whole_with_contact(pair):
         ends.append(end.x)
     whole, half = ends
     image = mirror_images(pair[0].rest, pair[0].names)
-    assert np.abs(whole[image] * [1.0, 1.0, -1.0] - whole).max() < 2e-3  # 0.0009 cm measured
-    assert np.abs(half - whole).max() < 2e-3  # 0.0006 cm measured
+    assert np.abs(whole[image] * [1.0, 1.0, -1.0] - whole).max() < 2e-3  # 0.0008 cm measured
+    assert np.abs(half - whole).max() < 2e-3  # 0.0012 cm measured
     assert np.abs(whole - pair[0].rest).max() > 0.3  # it did move
 
 
@@ -76,8 +76,9 @@ def test_a_sideways_load_on_a_halved_articulator_is_refused(art_half, art_whole)
 def test_the_dorsum_pressed_on_the_palate_stays_mirrored(pair):
     """6 N up on the dorsum for 200 ms: nodes slide along the palate, and the wall projects them every step.
     The halved articulator stays exactly symmetric (a mirrored node has no dofs, so a projection of its own
-    would stay with it: it did, up to 3.5 cm, before the projection was mirrored) and within 0.05 cm of the
-    whole one, which itself drifts 0.03 cm from symmetry (the palate's triangles are not mirror images)."""
+    would stay with it: it did, up to 3.5 cm, before the projection was mirrored) and with the whole one, whose
+    wall is mirror-symmetric too (0.0002 cm apart; 0.037 cm while the wall's quads were all split along the
+    same diagonal)."""
     from artic_cli.mechanics.loads import control_from_newtons
     from artic_cli.mechanics.simulate import run, settle
 
@@ -91,7 +92,8 @@ def test_the_dorsum_pressed_on_the_palate_stays_mirrored(pair):
     # 0.00004 cm: the midsagittal nodes' projections move them off their plane, and the mandible's carried points
     # follow an uneven frame of four bone nodes (exact while the bone is rigid, its links strain a little)
     assert np.abs(half[:, image] * [1.0, 1.0, -1.0] - half).max() < 1e-4
-    assert np.abs(half - whole).max() < 0.05
+    assert np.abs(half - whole).max() < 2e-3
+    assert np.abs(whole[:, image] * [1.0, 1.0, -1.0] - whole).max() < 2e-3
     assert np.abs(whole[-1] - whole[0]).max() > 0.5  # it did move
 
 
