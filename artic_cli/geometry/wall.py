@@ -4,8 +4,9 @@ Each wall part (palate with velum, posterior pharyngeal wall, lingual
 surface of the mandibular symphysis) is given as an outline per sagittal
 slice at z >= 0; slices are mirrored to -z, every outline is resampled to the
 same number of points by arc length, and neighbouring slices are joined by
-triangle strips whose diagonals mirror each other across z = 0.  Normals are unit vectors pointing *out of the lumen* (into
-the wall): a tongue point p is beyond a triangle when (p - q) . n > 0.
+triangle strips whose diagonals mirror each other across z = 0.  Normals are
+unit vectors pointing *out of the lumen* (into the wall): a tongue point p is
+beyond a triangle when (p - q) . n > 0.
 """
 
 from __future__ import annotations
