@@ -301,7 +301,7 @@ def _step_once(model: Model, state: State, control: Control, h: float) -> State:
     prev = None
     fresh = False
     fs = None
-    last = None  # (x, update, residual norm) of the last Newton update
+    last = None  # (update, residual norm before it) of the last Newton update
     halved = False
     for it in range(1, opt.max_iter + 1):
         a = c_a * x + a_known
@@ -320,10 +320,10 @@ def _step_once(model: Model, state: State, control: Control, h: float) -> State:
             factor = None  # contact set changed: keep the band, redo the small Woodbury part
         resid = reduce_t @ (model.mass @ a - f - f_ext).ravel()
         norm = float(np.linalg.norm(resid))
-        if last is not None and norm > last[2] and not halved:
+        if last is not None and norm > last[1] and not halved:
             # the update raised the residual (the tangent leaves out the bricks' indefinite second derivatives):
             # go back to half of it, once
-            x = last[0] - 0.5 * last[1]
+            x = x + 0.5 * last[0]
             halved = True
             continue
         halved = False
@@ -350,9 +350,8 @@ def _step_once(model: Model, state: State, control: Control, h: float) -> State:
             dx *= _MAX_INCREMENT / size
             if not fresh:
                 factor = base = None
-        update = (reduce @ dx).reshape(-1, 3)
-        last = (x.copy(), update, norm)
-        x -= update
+        last = ((reduce @ dx).reshape(-1, 3), norm)
+        x -= last[0]
         # stop when the error left after this update is below tol: the increment itself, or, with a
         # contraction rate theta < 1 measured, the geometric tail theta / (1 - theta) * size (Hairer &
         # Wanner's stopping rule for simplified Newton)

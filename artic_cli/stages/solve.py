@@ -64,12 +64,13 @@ def add_formants(ctx: Context, maps: Path | str, mesh: Path | str, config: Path 
     whole: list = []  # the maps with the EPs' shapes, read once when other lips or ports need them
 
     def formants(jaw: str, area: float, length: float, port: float) -> dict:
-        key = (jaw, round(area, 6), round(length, 6), round(port, 6))
+        key = (jaw, *am_stage.lip_key(area, length), round(port, 6))
         if key not in cache:
-            held = None if stored is None or key[3] != round(defaults[2], 6) else stored.formants_with(jaw, area, length)
-            if stored is not None and jaw in stored.jaws and key[1:] == tuple(round(v, 6) for v in defaults):
+            mapped = stored is not None and key[3] == round(defaults[2], 6)  # the acoustic maps hold the config's port
+            held = stored.formants_with(jaw, area, length) if mapped else None  # one of its mapped lip tubes
+            if mapped and jaw in stored.jaws and key[1:3] == am_stage.lip_key(*defaults[:2]):
                 cache[key] = {k: n.formants_hz for k, n in stored.jaws[jaw].items()}
-            elif held is not None:  # one of the config's mapped lip tubes, the port the config's
+            elif held is not None:
                 cache[key] = held
             else:
                 if not whole:
