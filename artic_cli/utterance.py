@@ -10,12 +10,16 @@ Example::
     force_course: static                 # optional: or pulse_step (config speech.force_course)
     segments:
       - {target: configs/targets/vowels/a.yaml, duration_ms: 250}
-      - {target: configs/targets/consonants/k.yaml, duration_ms: 80, voiced: false}
+      - {target: configs/targets/consonants/k.yaml, duration_ms: 80, voiced: false, lead_ms: 140, press: 1.5}
       - target: {name: a_open, jaw: {forces_n: {JO: 2.5}}, acoustic: {formants_hz: [753, 1385]}}   # inline
         duration_ms: 250
       - {forces_n: {JO: 1.0, GGp: 2.0}, duration_ms: 100, label: push}     # forces given, nothing solved
     tract:                               # optional lip and velum course on top of the targets' lips
       - {at_ms: 250, ramp_ms: 40, lip_area_cm2: 0.0}
+
+A segment's ``lead_ms`` overrides the utterance's for its forces alone (a stop's closing gesture starts earlier,
+its release comes with the next segment's forces); ``press`` scales a solved target's tongue-muscle forces (a
+stop presses on the wall: a virtual target beyond it; the jaw's forces are kept).
 
 A target path is read relative to the working folder, else to the utterance file's folder.
 """
@@ -41,11 +45,15 @@ class Segment(Strict):
     duration_ms: DurationMs
     voiced: bool = True
     label: SafeName | None = None  # the TextGrid's label (default: the target's name)
+    lead_ms: Annotated[float, Field(ge=0, le=300, allow_inf_nan=False)] | None = None  # else the utterance's
+    press: Annotated[float, Field(ge=1, le=3, allow_inf_nan=False)] = 1.0  # the target's tongue forces x this
 
     @model_validator(mode="after")
     def _one_source(self):
         if (self.target is None) == (self.forces_n is None):
             raise ValueError("give either 'target' (a target file or one inline) or 'forces_n', one of them")
+        if self.forces_n is not None and self.press != 1.0:
+            raise ValueError("'press' scales a solved target's forces; with 'forces_n' give the pressed forces")
         return self
 
 
@@ -83,6 +91,11 @@ class Utterance(Strict):
     @property
     def duration_ms(self) -> float:
         return float(sum(s.duration_ms for s in self.segments))
+
+    def leads_ms(self, default_ms: float) -> list[float]:
+        """Each segment's lead (ms): its own, else the utterance's, else ``default_ms``."""
+        base = default_ms if self.lead_ms is None else self.lead_ms
+        return [base if s.lead_ms is None else s.lead_ms for s in self.segments]
 
     def starts_ms(self) -> list[float]:
         out, t = [], 0.0

@@ -2,7 +2,10 @@
 
 On each grid line the tract is the stretch between the inner contour's last crossing and the outer wall's
 first crossing (s measured from the spine toward the wall); a tongue beyond the wall (contact) reads
-distance 0, a closure.  The area is A = alpha d^beta with one (alpha, beta) per region (Heinz & Stevens
+distance 0, a closure.  Contact is a point: a tongue surface node on the wall (within ``touch_cm``) lies
+between two grid lines, where no line sees it, and the straight chords to its neighbours leave a gap of
+hundredths of a millimetre on the lines beside it; so the two lines either side of such a node read distance
+0 too (the tract is closed where the tongue touches, wherever the lines fall).  The area is A = alpha d^beta with one (alpha, beta) per region (Heinz & Stevens
 1965; the regions' coefficients are the config's).  Each grid line is one section, as long as half the
 midline's distance to its neighbours on each side, so the section lengths add up to the midline's length;
 the lip tube (a control: length and area) follows as the last sections.  Everything is vectorised over
@@ -67,6 +70,41 @@ def inner_distance(grid: Grid, inner: np.ndarray, wall_s: np.ndarray, penetratio
     return np.where(np.isfinite(last), last, np.where(beyond, np.inf, np.nan))
 
 
+def point_segment_distance(points: np.ndarray, segs: np.ndarray) -> np.ndarray:
+    """(..., n) distance (cm) from each point (..., n, 2) to the nearest of the segments (S, 2, 2)."""
+    a, e = segs[:, 0, :], segs[:, 1, :] - segs[:, 0, :]
+    rel = points[..., None, :] - a  # (..., n, S, 2)
+    u = np.clip((rel * e).sum(-1) / np.maximum((e * e).sum(-1), _EPS), 0.0, 1.0)
+    return np.linalg.norm(rel - u[..., None] * e, axis=-1).min(axis=-1)
+
+
+def touched_lines(grid: Grid, points: np.ndarray, outer: np.ndarray, touch_cm: float) -> np.ndarray:
+    """(F, L) bool: for each of the points (F, n, 2) within ``touch_cm`` of the outer contour (S', 2, 2), the
+    two grid lines either side of it (the nearest line whose stretch 0 <= s <= reach passes it and its
+    neighbour across the point): a contact closes the stretch between them, and a contact sliding from one
+    stretch to the next keeps a line closed all the way (areas between frames are interpolated)."""
+    f, n = points.shape[:2]
+    out = np.zeros((f, grid.n_lines), bool)
+    if touch_cm <= 0 or n == 0:
+        return out
+    near = point_segment_distance(points, outer) <= touch_cm  # (F, n)
+    if not near.any():
+        return out
+    fr, k = np.nonzero(near)
+    rel = points[fr, k][:, None, :] - grid.origin[None]  # (P, L, 2)
+    s = (rel * grid.normal).sum(-1)
+    side = rel[..., 0] * grid.normal[:, 1] - rel[..., 1] * grid.normal[:, 0]  # signed distance across the line
+    off = np.where((s >= 0.0) & (s <= grid.reach_cm), np.abs(side), np.inf)
+    line = np.argmin(off, axis=1)
+    ok = np.isfinite(off[np.arange(len(line)), line])
+    rows = np.arange(len(line))
+    up = np.minimum(line + 1, grid.n_lines - 1)
+    across = np.where(np.sign(side[rows, up]) != np.sign(side[rows, line]), up, np.maximum(line - 1, 0))
+    out[fr[ok], line[ok]] = True
+    out[fr[ok], across[ok]] = True
+    return out
+
+
 def power_law(distance_cm: np.ndarray, alpha: np.ndarray, beta: np.ndarray) -> np.ndarray:
     """A = alpha d^beta (cm^2), 0 for d <= 0."""
     d = np.maximum(distance_cm, 0.0)
@@ -108,14 +146,18 @@ class AreaFunctions:
 
 def area_functions(grid: Grid, inner: np.ndarray, outer: np.ndarray, alpha: np.ndarray, beta: np.ndarray,
                    region_names: tuple[str, ...], lip_length_cm: np.ndarray, lip_area_cm2: np.ndarray,
-                   lip_sections: int, penetration_cm: float) -> AreaFunctions:
+                   lip_sections: int, penetration_cm: float, touch_points: np.ndarray | None = None,
+                   touch_cm: float = 0.0) -> AreaFunctions:
     """From inner contours (F, S, 2, 2), the fixed outer contour (S', 2, 2), the law's per-region
-    coefficients and the lip controls (F,) to the area functions.  Lines that miss a contour give NaN
-    distances (the caller says which)."""
+    coefficients and the lip controls (F,) to the area functions; the line nearest to each of
+    ``touch_points`` (F, n, 2: the tongue's surface nodes) within ``touch_cm`` of the wall reads a closure.
+    Lines that miss a contour give NaN distances (the caller says which)."""
     wall_s = wall_distance(grid, outer)
     inner_s = inner_distance(grid, inner, wall_s, penetration_cm)
     with np.errstate(invalid="ignore"):
         d = np.maximum(wall_s[None, :] - inner_s, 0.0)
+    if touch_points is not None:
+        d = np.where(touched_lines(grid, np.asarray(touch_points, float), outer, touch_cm) & np.isfinite(d), 0.0, d)
     mid_s = np.minimum(0.5 * (np.minimum(inner_s, wall_s[None, :]) + wall_s[None, :]), wall_s[None, :])
     midline = grid.origin[None] + mid_s[..., None] * grid.normal[None]
     area = power_law(d, alpha[grid.region][None, :], beta[grid.region][None, :])

@@ -6,7 +6,8 @@ sample; area changes between frames are interpolated sample by sample.  Each jun
 2 sum(A p_in) / sum(A) over the tubes that meet there, and each tube's outgoing wave is that pressure less
 its incoming one: between two sections the scattering r = (A_k - A_k+1) / (A_k + A_k+1), |r| <= 1 for every
 area, so a closure (area 0, held at 0.01 mm^2) reflects the wave whole and stays stable: silence behind it,
-a release when it opens.  A closed side branch (the piriform fossae, as the transfer function has them)
+a release when it opens; a closed section's waves are cleared (it holds no air column), so a closure that
+moves along the line leaves no trapped wave to click out when a section reopens.  A closed side branch (the piriform fossae, as the transfer function has them)
 joins at a three-tube junction.  Yielding walls, as the transfer function has them (mass, resistance and
 stiffness per unit area; Ishizaka et al. 1975's form): at each two-tube junction a patch of wall, the
 perimeter 2 sqrt(pi A) times a section's length, moves under the junction pressure and takes its volume
@@ -75,7 +76,7 @@ def _line(frame_areas, frame_index, source, glottal_reflection, rho, c, fs, loss
         w = pos - k0 if frame_areas.shape[0] > 1 else 0.0
         for j in range(n):
             a = (1.0 - w) * frame_areas[k0, j] + (w * frame_areas[k0 + 1, j] if frame_areas.shape[0] > 1 else 0.0)
-            area[j] = a if a > 1e-4 else 1e-4
+            area[j] = a if a > MIN_AREA_CM2 else MIN_AREA_CM2
         new_f[0] = glottal_reflection * bwd[0] + source[s] / area[0]
         for j in range(n - 1):  # each junction's pressure p / (rho c) = f + b from the flows U = A (f - b) into it
             a_sum = area[j] + area[j + 1]
@@ -124,8 +125,12 @@ def _line(frame_areas, frame_index, source, glottal_reflection, rho, c, fs, loss
         out[s] = u - last_u
         last_u = u
         for j in range(n):
-            fwd[j] = keep * new_f[j]
-            bwd[j] = keep * new_b[j]
+            if area[j] <= MIN_AREA_CM2:  # a closed section holds no air column: no wave stays trapped in it to
+                fwd[j] = 0.0  # leave as a click when it opens (its flow A (f - b) would jump with its area)
+                bwd[j] = 0.0
+            else:
+                fwd[j] = keep * new_f[j]
+                bwd[j] = keep * new_b[j]
     return out
 
 
@@ -134,11 +139,20 @@ def sections_for(length_cm: float, c_cm_s: float, fs_internal: float) -> int:
 
 
 def resample_tube(length_cm: np.ndarray, area_cm2: np.ndarray, n: int) -> np.ndarray:
-    """(n,) areas of a tube at n equal sections (the area at each new section's centre)."""
+    """(n,) areas of a tube at n equal sections: the area at each new section's centre, and 0 for a new
+    section that a closed one (area <= 0) overlaps, however short (a closure narrower than the line's
+    sections would otherwise fall between their centres and leak)."""
+    area = np.asarray(area_cm2, dtype=float)
     edges = np.concatenate([[0.0], np.cumsum(length_cm)])
-    centres = (np.arange(n) + 0.5) * edges[-1] / n
-    k = np.clip(np.searchsorted(edges, centres, side="right") - 1, 0, len(area_cm2) - 1)
-    return np.asarray(area_cm2, dtype=float)[k]
+    step = edges[-1] / n
+    centres = (np.arange(n) + 0.5) * step
+    k = np.clip(np.searchsorted(edges, centres, side="right") - 1, 0, len(area) - 1)
+    out = area[k]
+    for j in np.flatnonzero(area <= 0.0):
+        first = int(np.clip(np.floor(edges[j] / step), 0, n - 1))
+        last = int(np.clip(np.ceil(edges[j + 1] / step) - 1, first, n - 1))
+        out[first:last + 1] = 0.0
+    return out
 
 
 def side_branch(at_cm: float, tube_length_cm: float, n: int, branch_length_cm: np.ndarray,

@@ -131,15 +131,28 @@ class Outline:
     drawn: dict  # every part by name, for figures
 
 
+def split_at_x(p: np.ndarray, x: float) -> tuple[np.ndarray, np.ndarray]:
+    """A polyline (n, 2) whose x falls along it cut where it crosses ``x``: the part before (x >= ``x``) and the
+    part after, both holding the crossing point."""
+    after = np.flatnonzero(p[:, 0] < x)
+    if len(after) == 0 or after[0] == 0:
+        return (p, p[-1:]) if len(after) == 0 else (p[:1], p)
+    i = int(after[0])
+    w = (p[i - 1, 0] - x) / (p[i - 1, 0] - p[i, 0])
+    cut = p[i - 1] + w * (p[i] - p[i - 1])
+    return np.vstack([p[:i], cut]), np.vstack([cut, p[i:]])
+
+
 def outer_contour(vt: VocalTract, wall: WallGeometry) -> dict[str, np.ndarray]:
     """The fixed outer parts: lower pharyngeal wall, the contact wall's midsagittal pharynx, velum and hard
-    palate, the velopharyngeal port's line (the oral tract's top behind the velum), the upper incisor."""
-    mid = min(wall.slices, key=lambda s: s.z_cm)
-    palate = np.asarray(mid.palate, dtype=float)
-    hard = palate[palate[:, 0] >= vt.hard_palate_end_x_cm]
-    soft = palate[palate[:, 0] <= vt.hard_palate_end_x_cm]
-    return {"pharynx": np.vstack([np.asarray(mid.pharynx, float), np.asarray(vt.pharynx_lower_cm, float)]),
-            "velum": soft, "port": np.asarray(vt.velum_port_line_cm, float), "hard_palate": hard, "upper_incisor": np.asarray(vt.upper_incisor_cm, float)}
+    palate (as the contact wall has them: its outlines resampled, so the tongue touches the tract's wall where it
+    touches the contact wall), the velopharyngeal port's line (the oral tract's top behind the velum), the upper
+    incisor."""
+    mid = wall_at(wall, min(sl.z_cm for sl in wall.slices))
+    hard, soft = split_at_x(mid["palate"], vt.hard_palate_end_x_cm)
+    return {"pharynx": np.vstack([mid["pharynx"], np.asarray(vt.pharynx_lower_cm, float)]),
+            "velum": soft, "port": np.asarray(vt.velum_port_line_cm, float), "hard_palate": hard,
+            "upper_incisor": np.asarray(vt.upper_incisor_cm, float)}
 
 
 def outline(vt: VocalTract, wall: WallGeometry, tongue_cm: np.ndarray, jaw: tuple[np.ndarray, np.ndarray]
@@ -158,13 +171,17 @@ def outline(vt: VocalTract, wall: WallGeometry, tongue_cm: np.ndarray, jaw: tupl
     return Outline(inner=(larynx, tongue, bridge, lower_incisor), outer=tuple(fixed.values()), drawn=drawn)
 
 
-def wall_at(wall: WallGeometry, z: float, points: int = 40) -> dict[str, np.ndarray]:
+def wall_at(wall: WallGeometry, z: float, points: int | None = None) -> dict[str, np.ndarray]:
     """The contact wall's outlines (palate with velum, pharynx) at lateral offset ``z`` (cm), linear between
-    the config's slices (each resampled to ``points`` points by arc length)."""
+    the config's slices, each resampled by arc length to ``points`` points (default: the wall's own
+    ``points_per_outline``, so the outline is the contact wall's)."""
+    points = wall.points_per_outline if points is None else points
     slices = sorted(wall.slices, key=lambda sl: sl.z_cm)
     zs = np.array([sl.z_cm for sl in slices])
     if not zs[0] <= z <= zs[-1]:
         raise ValueError(f"z = {z} cm is outside the wall's slices ({zs[0]}-{zs[-1]} cm)")
+    if len(slices) == 1:
+        return {part: resample_polyline(getattr(slices[0], part), points) for part in ("palate", "pharynx")}
     j = int(np.clip(np.searchsorted(zs, z, side="right") - 1, 0, len(zs) - 2))
     w = (z - zs[j]) / (zs[j + 1] - zs[j])
     out = {}

@@ -29,6 +29,7 @@ from ..control.course import activated, course, pulse_step
 from ..control.solver import TargetSpec, parse_target
 from ..control.targets import load_target
 from ..errors import ArticError, NotPhysical, UnreachableTarget
+from ..geometry.anatomy import TONGUE_MUSCLES
 from ..io.fingerprint import digest
 from ..io.store import atomic_h5, atomic_path, open_artifact, stored_content_hash
 from ..mechanics.loads import muscle_force_vector, muscle_shares
@@ -85,6 +86,8 @@ class Spoken:
     activation_ms: tuple[float, float]  # the muscles' activation rise and fall time constants (0, 0: none)
     lead_ms: float = 0.0  # each segment's forces switch on this long before its sound
     prepare_ms: float = 0.0  # the first segment's forces switch on this long before the sound (>= lead_ms)
+    segment_lead_ms: np.ndarray | None = None  # (K,) each segment's own lead
+    press: np.ndarray | None = None  # (K,) each segment's tongue-force factor
 
 
 # --- the plan: targets -> forces ---------------------------------------------------------------------
@@ -279,18 +282,25 @@ def compute(u: Utterance, p: Plan, cfg: Config, mesh, wall, progress=None, model
         bad = [m for m in f if m not in names]
         if bad:
             raise ArticError(f"segment {k}: muscle '{bad[0]}' is unknown; valid: {', '.join(names)}")
-    vectors = np.array([muscle_force_vector(model, f) for f in p.forces_n])
+    tongue = set(TONGUE_MUSCLES)
+    vectors = np.array([muscle_force_vector(model, {m: v * (seg.press if m in tongue else 1.0) for m, v in f.items()})
+                        for f, seg in zip(p.forces_n, u.segments)])
     ramp_s = units.ms_to_s(sp.ramp_ms if u.ramp_ms is None else u.ramp_ms)
     how = sp.force_course if u.force_course is None else u.force_course
-    # every segment's forces switch on ``lead`` before its sound; the first one's ``prep`` (>= lead) before it,
-    # during a silent lead-in that the record leaves out (a speaker sets the articulators before voicing): the
-    # course's clock starts ``prep`` before the sound, its first segment lengthened by ``prep - lead``
+    # every segment's forces switch on its lead before its sound (the utterance's or the config's, or its own);
+    # the first one's ``prep`` (>= its lead) before it, during a silent lead-in that the record leaves out (a
+    # speaker sets the articulators before voicing): the course's clock starts ``prep`` before the sound
     lead = units.ms_to_s(sp.lead_ms if u.lead_ms is None else u.lead_ms)
-    prep = max(lead, units.ms_to_s(sp.prepare_ms if u.prepare_ms is None else u.prepare_ms))
-    starts = np.asarray(p.starts_s, float) + (prep - lead)
+    leads = units.ms_to_s(np.array(u.leads_ms(sp.lead_ms)))
+    prep = max(leads[0], units.ms_to_s(sp.prepare_ms if u.prepare_ms is None else u.prepare_ms))
+    duration = float(p.starts_s[-1] + p.durations_s[-1])
+    starts = np.asarray(p.starts_s, float) - leads + prep
     starts[0] = 0.0
-    durations = np.asarray(p.durations_s, float).copy()
-    durations[0] += prep - lead
+    for k in range(1, len(starts)):
+        if starts[k] <= starts[k - 1]:
+            raise ArticError(f"segments[{k}]: its forces would switch on {units.s_to_ms(leads[k]):g} ms before its "
+                             f"sound, not after segment {k - 1}'s; shorten its lead_ms or lengthen segment {k - 1}")
+    durations = np.diff(np.r_[starts, duration + prep])  # how long each segment's forces act
     sets = vectors
     if how == "pulse_step":
         for k, pair in enumerate(sp.pulse_antagonists):
@@ -302,7 +312,6 @@ def compute(u: Utterance, p: Plan, cfg: Config, mesh, wall, progress=None, model
         starts, sets = pulse_step(starts, durations, vectors, units.ms_to_s(sp.pulse_ms), sp.pulse_gain,
                                   units.newton_to_dyn(view.muscles.max_force_n), pairs)
     force_at = course(starts, sets, ramp_s)
-    duration = float(p.starts_s[-1] + p.durations_s[-1])
     if sp.activation_rise_ms > 0 or sp.activation_fall_ms > 0:
         force_at = activated(force_at, duration + prep, units.ms_to_s(sp.activation_rise_ms),
                              units.ms_to_s(sp.activation_fall_ms))
@@ -382,7 +391,8 @@ def compute(u: Utterance, p: Plan, cfg: Config, mesh, wall, progress=None, model
                   beyond_wall_cm=beyond,
                   force_course=how, ramp_ms=units.s_to_ms(ramp_s),
                   activation_ms=(sp.activation_rise_ms, sp.activation_fall_ms), lead_ms=units.s_to_ms(lead),
-                  prepare_ms=units.s_to_ms(prep))
+                  prepare_ms=units.s_to_ms(prep), segment_lead_ms=units.s_to_ms(leads),
+                  press=np.array([seg.press for seg in u.segments]))
 
 
 # --- files ---------------------------------------------------------------------------------------------
@@ -435,6 +445,11 @@ def write(wav: Path | str, s: Spoken, prov=None) -> dict[str, Path]:
         g.attrs["activation_ms"] = np.asarray(s.activation_ms, float)
         g.attrs["lead_ms"] = s.lead_ms
         g.attrs["prepare_ms"] = s.prepare_ms
+        k = len(p.labels)
+        g.create_dataset("lead", data=np.full(k, s.lead_ms) if s.segment_lead_ms is None else s.segment_lead_ms
+                         ).attrs["units"] = "ms: each segment's forces switch on this long before its sound"
+        g.create_dataset("press", data=np.ones(k) if s.press is None else s.press
+                         ).attrs["units"] = "factor on the solved target's tongue-muscle forces"
         g.create_dataset("lip_area", data=np.array([a for a, _ in p.lips])).attrs["units"] = "cm^2"
         g.create_dataset("lip_length", data=np.array([b for _, b in p.lips])).attrs["units"] = "cm"
         names = sorted({m for f_ in p.forces_n for m in f_})

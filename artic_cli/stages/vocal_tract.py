@@ -144,7 +144,7 @@ def compute(vt: VocalTract, cfg_wall, shapes: Shapes, controls: dict[str, np.nda
     law = vt.area_law
     af = area_functions(grid, inner, outer, np.array([r.alpha for r in law]), np.array([r.beta for r in law]),
                         tuple(r.name for r in law), controls["lip_length_cm"], controls["lip_area_cm2"],
-                        vt.lip_sections, vt.grid.penetration_cm)
+                        vt.lip_sections, vt.grid.penetration_cm, moving["tongue"], vt.grid.touch_cm)
     missing_wall = np.flatnonzero(np.isnan(af.wall_s_cm))
     if len(missing_wall):
         k = int(missing_wall[0])
