@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from artic_cli.acoustics.area_function import area_functions, segments
+from artic_cli.acoustics.area_function import area_functions, segments, touched_lines
 from artic_cli.config import AreaRegion
 from artic_cli.geometry.tract import tract_grid
 from artic_cli.schedule import TractEntry, tract_controls
@@ -83,3 +83,30 @@ def test_the_band_area_of_a_uniform_slab_is_its_width_times_its_depth(cfg):
     outers = [segments(outer), segments([(outer[0] + side[0]) / 2]), segments(side)]
     band = band_areas(grid, planes, outers, np.array([0.0, 0.5, 1.0]), af.inner_s_cm, af.wall_s_cm)
     np.testing.assert_allclose(band, 2 * (0.25 * 0.8 + 0.5 * 0.7 + 0.25 * 0.6), rtol=1e-12)
+
+
+def test_a_node_on_the_wall_between_two_lines_closes_both_and_one_below_it_does_not(cfg):
+    """Contact is a point: a tongue node on the wall half-way between two grid lines, the chords to its
+    neighbours 0.3 cm below, leaves both lines open by their crossings; the touch rule closes them."""
+    vt = _channel_tract(cfg, [AreaRegion(name="all", until_cm=99.0, alpha=1.7, beta=1.3)])
+    grid = tract_grid(vt)
+    x = grid.origin[:, 0]
+    mid = 0.5 * (x[10] + x[11])
+    outer = [np.array([[-1.0, 0.5], [8.0, 0.5]])]
+    law = vt.area_law
+    for gap, closed in ((0.0, True), (0.005, True), (0.05, False)):
+        node = np.array([mid, 0.5 - gap])
+        inner = [np.array([[-1.0, 0.2], [mid - 1.0, 0.2], node, [mid + 1.0, 0.2], [8.0, 0.2]])]
+        af = area_functions(grid, segments(inner)[None], segments(outer), np.array([r.alpha for r in law]),
+                            np.array([r.beta for r in law]), tuple(r.name for r in law), np.array([1.0]),
+                            np.array([2.0]), vt.lip_sections, vt.grid.penetration_cm, node[None, None], 0.01)
+        d = af.distance_cm[0]
+        assert (d[[10, 11]] == 0.0).all() == closed, (gap, d[[10, 11]])
+        far = np.abs(x - mid) > 1.0
+        np.testing.assert_allclose(d[far], 0.3)  # nothing else closes: the chords' lines read their gap
+        assert (d[~far & (np.abs(x - mid) > 0.3)] > 0.0).all()
+        if not closed:
+            assert (d[[10, 11]] > gap).all()
+    # without the rule the lines read the chords' gap however close the node
+    plain = touched_lines(grid, np.array([[[mid, 0.5]]]), segments(outer), 0.0)
+    assert not plain.any()

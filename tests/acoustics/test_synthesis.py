@@ -56,6 +56,31 @@ def test_a_closure_stays_stable_and_silent_behind_it(walls):
     assert np.isfinite(y_slit).all() and np.abs(y_slit).max() < np.abs(y_open).max()
 
 
+def test_a_closure_shorter_than_the_line_s_sections_still_closes_one():
+    # a 0.3-cm closure between two of the line's section centres (sections 0.4 cm long here)
+    area = resample_tube(np.array([4.1, 0.3, 3.6]), np.array([2.0, 0.0, 3.0]), 20)
+    assert (area == 0.0).sum() == 1 and area[10] == 0.0
+    assert (area[:10] == 2.0).all() and (area[11:] == 3.0).all()
+
+
+@pytest.mark.parametrize("walls", [None, (2.4, 5000.0, 1.0e5)], ids=["rigid", "yielding"])
+def test_a_closure_sliding_along_the_line_stays_silent(walls):
+    """A closure that moves from one section to the next (a tongue sliding on the palate) leaves no wave
+    trapped in the section that reopens: no click while it is shut."""
+    fs = 88200
+    open_ = resample_tube(np.array([17.5]), np.array([4.0]), 44)
+    here, there = open_.copy(), open_.copy()
+    here[30:32] = 0.0
+    there[31:33] = 0.0
+    src = lf_flow_derivative(np.full(fs // 4, 110.0), fs)
+    frames = np.array([open_, here, here, there, there, here, here, open_])
+    times = np.array([0.0, 0.05, 0.08, 0.09, 0.12, 0.13, 0.18, 0.19])
+    y = synthesize(frames, times, src, fs, walls=walls)
+    voice = np.abs(y[int(0.01 * fs): int(0.04 * fs)]).max()
+    # shut from 0.05 s: the front cavity rings down, then nothing while the closure slides (0.08-0.18 s)
+    assert np.isfinite(y).all() and np.abs(y[int(0.08 * fs): int(0.18 * fs)]).max() < 0.01 * voice
+
+
 @pytest.mark.parametrize("vowel", sorted(VOWELS))
 def test_praat_measures_our_transfer_function_formants_in_the_sound(vowel, tmp_path):
     pytest.importorskip("parselmouth")

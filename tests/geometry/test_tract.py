@@ -1,11 +1,12 @@
-"""The tract's moving inner contour: the larynx front moved by the tongue root."""
+"""The tract's contours: the larynx front moved by the tongue root; the outer wall the contact wall's own."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from artic_cli.geometry.tract import larynx_front
+from artic_cli.acoustics.area_function import point_segment_distance
+from artic_cli.geometry.tract import larynx_front, outer_contour
 
 WALL = np.array([[-7.8, 0.0], [-7.6, -5.0], [-7.2, -8.0], [-7.15, -8.3]])  # posterior wall, top to bottom
 
@@ -42,3 +43,30 @@ def test_a_share_of_zero_keeps_the_larynx_fixed(cfg):
     vt = cfg.vocal_tract.model_copy(update={"larynx_follows_root": 0.0})
     out = larynx_front(vt, np.array([[1.0, 0.0]]), 1, WALL)
     np.testing.assert_allclose(out[0], np.asarray(vt.larynx_front_cm, float))
+
+
+def test_the_tract_s_palate_and_pharynx_are_the_contact_wall_s_midsagittal_section(cfg):
+    """A tongue node resting on the contact wall lies on the tract's outer contour: the contact wall's
+    triangles in the midsagittal plane (their edges along the z = 0 slice) are the outline's segments, and the
+    hard palate and velum meet at one point."""
+    from artic_cli.geometry.wall import PARTS, wall_surface
+
+    wall = wall_surface(cfg.speaker.wall)
+    skull = np.unique(wall.triangles[np.isin(wall.part, [PARTS.index("palate"), PARTS.index("pharynx")])])
+    out = outer_contour(cfg.vocal_tract, cfg.speaker.wall)
+    segs = np.concatenate([np.stack([p[:-1], p[1:]], axis=1) for p in out.values() if len(p) > 1])
+    mid = skull[np.abs(wall.vertices[skull, 2]) < 1e-12]
+    assert len(mid) >= 2 * cfg.speaker.wall.points_per_outline
+    d = point_segment_distance(wall.vertices[mid, :2][None], segs)[0]
+    assert d.max() < 1e-9
+    # ... and the other way: the outline's corners lie on the wall's midsagittal edges (the config's own
+    # polylines have corners that the wall's resampled slices cut by up to 0.03 cm)
+    tri = wall.triangles[np.isin(wall.part, [PARTS.index("palate"), PARTS.index("pharynx")])]
+    edges = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])
+    flat = edges[(np.abs(wall.vertices[edges, 2]) < 1e-12).all(axis=1)]
+    wall_segs = wall.vertices[flat][:, :, :2]
+    corners = np.concatenate([out[k] for k in ("hard_palate", "velum")] + [out["pharynx"][:-len(
+        cfg.vocal_tract.pharynx_lower_cm)]])
+    assert point_segment_distance(corners[None], wall_segs)[0].max() < 1e-9
+    np.testing.assert_allclose(out["hard_palate"][-1], out["velum"][0])
+    assert out["hard_palate"][-1, 0] == pytest.approx(cfg.vocal_tract.hard_palate_end_x_cm)

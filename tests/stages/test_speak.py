@@ -41,6 +41,9 @@ A = {"forces_n": {"JO": 2.5, "HG": 1.0}, "duration_ms": 150, "label": "a"}  # th
     ({"segments": [{"target": "no/such/target.yaml", "duration_ms": 100}]}, "target file not found"),
     ({"segments": [dict(A, forces_n={"XYZ": 1.0})]}, "'XYZ' is unknown"),
     ({"segments": [dict(A, forces_n={"GGp": -1.0})]}, "forces_n.GGp"),
+    ({"segments": [dict(A, press=1.5)]}, "'press' scales a solved target's forces"),
+    ({"segments": [A], "lead_ms": 0, "prepare_ms": 0, "segments": [A, dict(A, lead_ms=200)]}, "shorten its lead_ms"),
+    ({"segments": [dict(A, lead_ms=-10)]}, "segments.0.lead_ms"),
     ({"segments": [{"target": {"name": "x", "crucial": {"point": "tip", "at_cm": [0, 0]}, "acoustic":
                                 {"formants_hz": [500, 1500]}}, "duration_ms": 100}]}, "one of them"),
 ])
@@ -249,6 +252,42 @@ def test_preparing_switches_only_the_first_segment_s_forces_on_earlier(tmp_path,
     for t_s in (0.09, 0.11):
         np.testing.assert_allclose(_commanded_at(prepared, t_s), _commanded_at(lead, t_s), atol=1e-3)
     assert not np.allclose(_commanded_at(lead, 0.09), _commanded_at(lead, 0.11))
+
+
+def test_a_segment_s_own_lead_moves_its_forces_alone_and_press_scales_only_the_tongue(tmp_path, mesh_file, cfg):
+    doc = dict(OPEN_THEN_PUSH, lead_ms=0, prepare_ms=0, name="own")
+    doc["segments"] = [doc["segments"][0], dict(doc["segments"][1], lead_ms=100)]
+    res = _run("speak", _write(tmp_path / "own.yaml", doc), "--mesh", mesh_file, "--out", tmp_path / "own.wav")
+    assert res.exit_code == 0, res.output
+    rec = speak.read(tmp_path / "own.h5")
+    import h5py
+
+    with h5py.File(tmp_path / "own.h5") as f:
+        names = [str(n) for n in f["muscles"].attrs["names"]]
+        np.testing.assert_allclose(f["segments/lead"][()], [0.0, 100.0])
+    ggp = [k for k, n in enumerate(names) if n.startswith("GGp")]
+    assert _commanded_at(rec, 0.04)[ggp].sum() == 0.0  # the push's forces switch on at 0.05 s ...
+    assert _commanded_at(rec, 0.14)[ggp].sum() > 1.9  # ... not at its sound (0.15 s)
+    # press: a solved target's tongue forces times the factor, the jaw's kept (the plan given, nothing solved)
+    from artic_cli.stages import mesh as mesh_stage
+    from artic_cli.utterance import parse_utterance
+
+    target = {"name": "k", "jaw": {"forces_n": {"JO": 1.0}}, "crucial": {"point": "dorsum", "at_cm": [-4.4, 1.6]}}
+    u = parse_utterance({"segments": [{"target": target, "duration_ms": 60, "press": 1.5}], "force_course": "static",
+                         "lead_ms": 0, "prepare_ms": 0, "ramp_ms": 0})
+    plan = speak.Plan(labels=["k"], starts_s=np.array([0.0]), durations_s=np.array([0.06]),
+                      forces_n=[{"JO": 1.0, "SG": 2.0}], lips=[(3.0, 1.0)], ports=[0.0], voiced=np.array([False]),
+                      notes=["solved"], solutions=[""])
+    m = mesh_stage.read(mesh_file, cfg)
+    said = speak.compute(u, plan, cfg, m.mesh, m.wall)
+    held = said.muscle_force_n[-1]
+    sg = said.muscle_names.index("SG")
+    jaw = [said.muscle_names.index(n) for n in ("anterior_digastric", "lateral_pterygoid_lower")]
+    unpressed = speak.compute(u.model_copy(update={"segments": [u.segments[0].model_copy(update={"press": 1.0})]}),
+                              plan, cfg, m.mesh, m.wall).muscle_force_n[-1]
+    assert held[sg] == pytest.approx(1.5 * unpressed[sg], rel=1e-9) and unpressed[sg] > 1.9  # SG 2 N pressed
+    np.testing.assert_allclose(held[jaw], unpressed[jaw], rtol=1e-9)  # JO's muscles as they were
+    assert min(held[jaw]) > 0.1
 
 
 def test_an_unreachable_target_exits_3_naming_its_segment_and_writes_nothing(tmp_path, mesh_file):
