@@ -428,7 +428,8 @@ def utterance_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row
     lines = ["Each utterance is a list of targets with durations (`configs/utterances/`), spoken by `artic speak "
              f"--accept-nearest`: every target solved once, its forces ramped in over {ramp} and held (the paper's "
              "static forces) or opened with a pulse (`pulse_step`, beyond the paper), switched on at the segment's "
-             f"start or a lead before it (each line names its course){lag}, the whole simulated with contact, then "
+             "start or a lead before it (each line names its course and lead, a segment its own lead and a stop "
+             f"its press on the solved forces){lag}, the whole simulated with contact, then "
              "tract, formants and sound (LF voice, off in voiceless segments; turbulence noise at the narrowest "
              "place).  Formants are our transfer function's, medians over each segment's middle half.", ""]
     pictures: list[str] = []
@@ -437,8 +438,13 @@ def utterance_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row
         y, rate = read_wav(wav)
         m = speak_stage.measures(rec, y, rate)
         name = str(rec.attrs.get("name", path.stem))
-        segs = "; ".join(f"{s['label']} ({h}) F1 / F2 {s['f1_hz']:.0f} / {s['f2_hz']:.0f} Hz"
-                         for s, h in zip(m["segments"], rec.how))
+        k = len(rec.how)
+        leads = rec.leads_ms if rec.leads_ms is not None else np.full(k, rec.lead_ms)
+        press = rec.press if rec.press is not None else np.ones(k)
+        own = [(f", {lead:g} ms ahead" if lead != rec.lead_ms else "") + (f", pressed x{f:g}" if f != 1.0 else "")
+               for lead, f in zip(leads, press)]
+        segs = "; ".join(f"{s['label']} ({h}{o}) F1 / F2 {s['f1_hz']:.0f} / {s['f2_hz']:.0f} Hz"
+                         for s, h, o in zip(m["segments"], rec.how, own))
         clos = ", ".join(f"{c['duration_ms']:.0f} ms at {c['start_s']:.2f} s" for c in m["closures"]) or "none"
         sp = m["peak_speed_cm_s"]
         tg = path.with_suffix(".TextGrid")

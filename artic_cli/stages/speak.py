@@ -512,6 +512,8 @@ class Record:
     activation_ms: tuple[float, float]
     lead_ms: float = 0.0
     prepare_ms: float = 0.0
+    leads_ms: np.ndarray | None = None  # (K,) each segment's own lead
+    press: np.ndarray | None = None  # (K,) each segment's tongue-force factor
 
 
 def read(path: Path | str) -> Record:
@@ -530,7 +532,9 @@ def read(path: Path | str) -> Record:
                           ramp_ms=float(g.attrs.get("ramp_ms", 30.0)),
                           activation_ms=tuple(float(v) for v in g.attrs.get("activation_ms", (0.0, 0.0))),
                           lead_ms=float(g.attrs.get("lead_ms", 0.0)),
-                          prepare_ms=float(g.attrs.get("prepare_ms", g.attrs.get("lead_ms", 0.0))))
+                          prepare_ms=float(g.attrs.get("prepare_ms", g.attrs.get("lead_ms", 0.0))),
+                          leads_ms=g["lead"][()] if "lead" in g else None,
+                          press=g["press"][()] if "press" in g else None)
         except (KeyError, ValueError, OSError) as err:
             raise ArticError(f"{path} is damaged or incomplete ({type(err).__name__}); {STAGE.hint}") from None
 
