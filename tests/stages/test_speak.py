@@ -138,6 +138,32 @@ def test_a_closure_is_silent_and_its_release_makes_a_burst(spoken):
     assert np.all(np.isnan(rec.formants_hz[(rec.time_s > c["start_s"] + 0.01) & (rec.time_s < c["end_s"] - 0.01)]))
 
 
+def test_a_velar_stop_closes_on_the_palate_silently_then_bursts(tmp_path, mesh_file):
+    """/aka/ as configs/utterances/aka.yaml times it, the forces given: /a/'s as solved (GGp 0.54 N, JO 6 N),
+    /k/'s as solved (GGp 2 N + SG 1.89 N, JO 0.5 N) pressed by 1.3; the tongue on the palate closes the tract
+    (contact read as closure), the closure is silent (no clicks as it slides) and its release bursts."""
+    a = {"forces_n": {"GGp": 0.54, "JO": 6.0}, "label": "a"}
+    doc = {"name": "aka", "f0_hz": [[0.0, 125], [0.6, 100]],
+           "segments": [dict(a, duration_ms=250),
+                        {"forces_n": {"GGp": 2.6, "SG": 2.457, "JO": 0.5}, "duration_ms": 90, "voiced": False,
+                         "label": "k", "lead_ms": 130},
+                        dict(a, duration_ms=260, lead_ms=40)]}
+    res = _run("speak", _write(tmp_path / "aka.yaml", doc), "--mesh", mesh_file, "--out", tmp_path / "aka.wav")
+    assert res.exit_code == 0, res.output
+    rec = speak.read(tmp_path / "aka.h5")
+    y, rate = read_wav(tmp_path / "aka.wav")
+    m = speak.measures(rec, y, rate)
+    assert len(m["closures"]) == 1, m["closures"]
+    (c,) = m["closures"]
+    assert 40 <= c["duration_ms"] <= 120 and 0.23 <= c["start_s"] <= 0.27
+    vowel_db = np.mean([s["level_db"] for s in m["segments"] if s["label"] == "a"])
+    assert c["level_db"] < vowel_db - 30
+    burst = band_level_db(y, rate, c["end_s"], c["end_s"] + 0.015, 3000.0)
+    assert burst > band_level_db(y, rate, c["start_s"] + 0.01, c["end_s"] - 0.01, 3000.0) + 40
+    assert rec.attrs["max_beyond_wall_cm"] <= 0.01 and np.nanmax(np.abs(rec.volume_change)) <= 0.003
+    assert m["peak_speed_cm_s"]["dorsum"] <= 48.0
+
+
 def test_a_narrow_channel_makes_frication_that_the_noise_switch_removes(spoken, mesh_file, tmp_path):
     rec = speak.read(spoken / "lab.h5")
     y, rate = read_wav(spoken / "lab.wav")
