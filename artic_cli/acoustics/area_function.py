@@ -4,12 +4,12 @@ On each grid line the tract is the stretch between the inner contour's last cros
 first crossing (s measured from the spine toward the wall); a tongue beyond the wall (contact) reads
 distance 0, a closure.  Contact is a point: a tongue surface node on the wall (within ``touch_cm``) lies
 between two grid lines, where no line sees it, and the straight chords to its neighbours leave a gap of
-hundredths of a millimetre on the lines beside it; so the two lines either side of such a node read distance
-0 too (the tract is closed where the tongue touches, wherever the lines fall).  The area is A = alpha d^beta with one (alpha, beta) per region (Heinz & Stevens
-1965; the regions' coefficients are the config's).  Each grid line is one section, as long as half the
-midline's distance to its neighbours on each side, so the section lengths add up to the midline's length;
-the lip tube (a control: length and area) follows as the last sections.  Everything is vectorised over
-frames: contours (F, S, 2, 2) as segments.
+about 0.1 mm on the lines beside it; so the two lines either side of such a node read distance 0 too (the
+tract is closed where the tongue touches, wherever the lines fall).  The area is A = alpha d^beta with one
+(alpha, beta) per region (Heinz & Stevens 1965; the regions' coefficients are the config's).  Each grid
+line is one section, as long as half the midline's distance to its neighbours on each side, so the section
+lengths add up to the midline's length; the lip tube (a control: length and area) follows as the last
+sections.  Everything is vectorised over frames: contours (F, S, 2, 2) as segments.
 """
 
 from __future__ import annotations
@@ -149,8 +149,8 @@ def area_functions(grid: Grid, inner: np.ndarray, outer: np.ndarray, alpha: np.n
                    lip_sections: int, penetration_cm: float, touch_points: np.ndarray | None = None,
                    touch_cm: float = 0.0) -> AreaFunctions:
     """From inner contours (F, S, 2, 2), the fixed outer contour (S', 2, 2), the law's per-region
-    coefficients and the lip controls (F,) to the area functions; the line nearest to each of
-    ``touch_points`` (F, n, 2: the tongue's surface nodes) within ``touch_cm`` of the wall reads a closure.
+    coefficients and the lip controls (F,) to the area functions; the two lines either side of each of
+    ``touch_points`` (F, n, 2: the tongue's surface nodes) within ``touch_cm`` of the wall read a closure.
     Lines that miss a contour give NaN distances (the caller says which)."""
     wall_s = wall_distance(grid, outer)
     inner_s = inner_distance(grid, inner, wall_s, penetration_cm)
