@@ -18,8 +18,8 @@ Example::
       - {at_ms: 250, ramp_ms: 40, lip_area_cm2: 0.0}
 
 A segment's ``lead_ms`` overrides the utterance's for its forces alone (a stop's closing gesture starts earlier,
-its release comes with the next segment's forces); ``press`` scales a solved target's tongue-muscle forces (a
-stop presses on the wall: a virtual target beyond it; the jaw's forces are kept).
+its release comes with the next segment's forces); ``press`` scales a solved target's tongue-muscle forces, up
+to ``muscles.max_force_n`` (a stop presses on the wall: a virtual target beyond it; the jaw's forces are kept).
 
 A target path is read relative to the working folder, else to the utterance file's folder.
 """

@@ -7,18 +7,19 @@ sample; area changes between frames are interpolated sample by sample.  Each jun
 its incoming one: between two sections the scattering r = (A_k - A_k+1) / (A_k + A_k+1), |r| <= 1 for every
 area, so a closure (area 0, held at 0.01 mm^2) reflects the wave whole and stays stable: silence behind it,
 a release when it opens; a closed section's waves are cleared (it holds no air column), so a closure that
-moves along the line leaves no trapped wave to click out when a section reopens.  A closed side branch (the piriform fossae, as the transfer function has them)
-joins at a three-tube junction.  Yielding walls, as the transfer function has them (mass, resistance and
-stiffness per unit area; Ishizaka et al. 1975's form): at each two-tube junction a patch of wall, the
-perimeter 2 sqrt(pi A) times a section's length, moves under the junction pressure and takes its volume
-velocity from the junction's flow (the wall's velocity and the junction's pressure solved together, a
-backward-Euler step).  The glottis end reflects with ``glottal_reflection`` (nearly closed).  The lips
-reflect through the same radiation load as the frequency-domain model (a piston in a baffle, parallel R-L),
-as a first-order filter (bilinear transform of (Z - Zc) / (Z + Zc), Zc = rho c / A_lips): -1 at low
-frequencies, with the end correction that lowers the formants of a wide mouth.  Each section passes
-``1 - section_loss`` of a wave (boundary-layer losses lumped).  Turbulence noise (frication, bursts) enters
-as a series pressure source at a junction, half its pressure sent each way.  The radiated sound is the time
-derivative of the lips' volume velocity, brought to the audio rate by a polyphase filter.
+moves along the line leaves no trapped wave to click out when a section reopens.  A closed side branch (the
+piriform fossae, as the transfer function has them) joins at a three-tube junction.  Yielding walls, as the
+transfer function has them (mass, resistance and stiffness per unit area; Ishizaka et al. 1975's form): at
+each two-tube junction a patch of wall, the perimeter 2 sqrt(pi A) times a section's length, moves under the
+junction pressure and takes its volume velocity from the junction's flow (the wall's velocity and the
+junction's pressure solved together, a backward-Euler step).  The glottis end reflects with
+``glottal_reflection`` (nearly closed).  The lips reflect through the same radiation load as the
+frequency-domain model (a piston in a baffle, parallel R-L), as a first-order filter (bilinear transform of
+(Z - Zc) / (Z + Zc), Zc = rho c / A_lips): -1 at low frequencies, with the end correction that lowers the
+formants of a wide mouth.  Each section passes ``1 - section_loss`` of a wave (boundary-layer losses
+lumped).  Turbulence noise (frication, bursts) enters as a series pressure source at a junction, half its
+pressure sent each way.  The radiated sound is the time derivative of the lips' volume velocity, brought to
+the audio rate by a polyphase filter.
 """
 
 from __future__ import annotations

@@ -348,7 +348,8 @@ def tract_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row], l
         every = [v for v in JAPANESE_VOWELS if v in reached or any(v in r for r in lipped.values())]
         with_lips = "".join(f"; with lips {a:g} cm^2 x {b:g} cm: {' '.join(r) or 'none'}"
                             for (a, b), r in lipped.items())
-        rows.append(Row("EP maps in the F1-F2 plane (every jaw position; the lips a control)", "male Japanese a i u e o",
+        rows.append(Row("EP maps in the F1-F2 plane (every jaw position; the lips a control)",
+                        "male Japanese a i u e o",
                         f"{len(pts)} EPs: F1 {np.nanmin(pts[:, 0]):.0f}-{np.nanmax(pts[:, 0]):.0f} Hz, F2 "
                         f"{np.nanmin(pts[:, 1]):.0f}-{np.nanmax(pts[:, 1]):.0f} Hz; vowels within 10 %, default lips: "
                         f"{' '.join(reached) or 'none'}{with_lips}",

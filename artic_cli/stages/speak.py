@@ -282,9 +282,10 @@ def compute(u: Utterance, p: Plan, cfg: Config, mesh, wall, progress=None, model
         bad = [m for m in f if m not in names]
         if bad:
             raise ArticError(f"segment {k}: muscle '{bad[0]}' is unknown; valid: {', '.join(names)}")
-    tongue = set(TONGUE_MUSCLES)
-    vectors = np.array([muscle_force_vector(model, {m: v * (seg.press if m in tongue else 1.0) for m, v in f.items()})
-                        for f, seg in zip(p.forces_n, u.segments)])
+    tongue, most = set(TONGUE_MUSCLES), view.muscles.max_force_n
+    vectors = np.array([muscle_force_vector(model, {m: min(v * seg.press, max(v, most)) if m in tongue else v
+                                                    for m, v in f.items()})
+                        for f, seg in zip(p.forces_n, u.segments)])  # a press stops at the muscles' largest force
     ramp_s = units.ms_to_s(sp.ramp_ms if u.ramp_ms is None else u.ramp_ms)
     how = sp.force_course if u.force_course is None else u.force_course
     # every segment's forces switch on its lead before its sound (the utterance's or the config's, or its own);
