@@ -373,8 +373,8 @@ class TractGrid(Strict):
     reach_cm: Annotated[float, Field(gt=0.5, le=6.0, allow_inf_nan=False)] = 3.0  # each side of the spine
     smoothing_cm: NonNeg = 0.6  # the spine is smoothed over this arc length before the normals are taken
     penetration_cm: Positive = 0.3  # tongue beyond the wall by up to this reads as a closure, not a miss
-    # a tongue surface node this close to the wall (the contact's tolerance) closes the grid line nearest to it
-    # (0: the lines' crossings alone, which miss a contact between two lines)
+    # a tongue surface node this close to the wall (the contact's tolerance) closes the two grid lines either side
+    # of it (0: the lines' crossings alone, which miss a contact between two lines)
     touch_cm: Annotated[float, Field(ge=0, le=0.1, allow_inf_nan=False)] = 0.01
 
 

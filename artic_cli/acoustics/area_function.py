@@ -96,8 +96,8 @@ def touched_lines(grid: Grid, points: np.ndarray, outer: np.ndarray, touch_cm: f
     side = rel[..., 0] * grid.normal[:, 1] - rel[..., 1] * grid.normal[:, 0]  # signed distance across the line
     off = np.where((s >= 0.0) & (s <= grid.reach_cm), np.abs(side), np.inf)
     line = np.argmin(off, axis=1)
-    ok = np.isfinite(off[np.arange(len(line)), line])
     rows = np.arange(len(line))
+    ok = np.isfinite(off[rows, line])
     up = np.minimum(line + 1, grid.n_lines - 1)
     across = np.where(np.sign(side[rows, up]) != np.sign(side[rows, line]), up, np.maximum(line - 1, 0))
     out[fr[ok], line[ok]] = True

@@ -58,6 +58,11 @@ class AcousticMaps:
         """(P, 4) every EP's formants at a jaw position (the rest first)."""
         return np.concatenate([n.formants_hz.reshape(-1, FORMANTS) for n in self.jaws[jaw].values()])
 
+    def points_with_lips(self) -> dict[tuple[float, float], np.ndarray]:
+        """(area cm^2, length cm) -> (P, 4) every EP's formants at every jaw position with that mapped lip tube."""
+        return {key: np.concatenate([f.reshape(-1, FORMANTS) for nets in jaws.values() for f in nets.values()])
+                for key, jaws in self.lips.items()}
+
 
 def lip_key(area_cm2: float, length_cm: float) -> tuple[float, float]:
     """How a lip tube is looked up (cm^2, cm; rounded to 1e-6)."""

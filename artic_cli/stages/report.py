@@ -343,8 +343,7 @@ def tract_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row], l
 
         reached = within(pts)
         # the lips are a control: the maps also hold every EP's formants with the config's mapped lip tubes
-        lipped = {key: within(np.concatenate([f.reshape(-1, f.shape[-1])[:, :2] for nets in jaws.values()
-                                              for f in nets.values()])) for key, jaws in am.lips.items()}
+        lipped = {key: within(f[:, :2]) for key, f in am.points_with_lips().items()}
         every = [v for v in JAPANESE_VOWELS if v in reached or any(v in r for r in lipped.values())]
         with_lips = "".join(f"; with lips {a:g} cm^2 x {b:g} cm: {' '.join(r) or 'none'}"
                             for (a, b), r in lipped.items())
@@ -450,11 +449,8 @@ def utterance_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row
         y, rate = read_wav(wav)
         m = speak_stage.measures(rec, y, rate)
         name = str(rec.attrs.get("name", path.stem))
-        k = len(rec.how)
-        leads = rec.leads_ms if rec.leads_ms is not None else np.full(k, rec.lead_ms)
-        press = rec.press if rec.press is not None else np.ones(k)
         own = [(f", {lead:g} ms ahead" if lead != rec.lead_ms else "") + (f", pressed x{f:g}" if f != 1.0 else "")
-               for lead, f in zip(leads, press)]
+               for lead, f in zip(rec.leads_ms, rec.press)]
         segs = "; ".join(f"{s['label']} ({h}{o}) F1 / F2 {s['f1_hz']:.0f} / {s['f2_hz']:.0f} Hz"
                          for s, h, o in zip(m["segments"], rec.how, own))
         clos = ", ".join(f"{c['duration_ms']:.0f} ms at {c['start_s']:.2f} s" for c in m["closures"]) or "none"

@@ -15,7 +15,7 @@ freshness record and is written last.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Callable
 
@@ -86,8 +86,8 @@ class Spoken:
     activation_ms: tuple[float, float]  # the muscles' activation rise and fall time constants (0, 0: none)
     lead_ms: float = 0.0  # each segment's forces switch on this long before its sound
     prepare_ms: float = 0.0  # the first segment's forces switch on this long before the sound (>= lead_ms)
-    segment_lead_ms: np.ndarray | None = None  # (K,) each segment's own lead
-    press: np.ndarray | None = None  # (K,) each segment's tongue-force factor
+    segment_lead_ms: np.ndarray = field(default_factory=lambda: np.zeros(0))  # (K,) each segment's own lead
+    press: np.ndarray = field(default_factory=lambda: np.zeros(0))  # (K,) each segment's tongue-force factor
 
 
 # --- the plan: targets -> forces ---------------------------------------------------------------------
@@ -446,11 +446,9 @@ def write(wav: Path | str, s: Spoken, prov=None) -> dict[str, Path]:
         g.attrs["activation_ms"] = np.asarray(s.activation_ms, float)
         g.attrs["lead_ms"] = s.lead_ms
         g.attrs["prepare_ms"] = s.prepare_ms
-        k = len(p.labels)
-        g.create_dataset("lead", data=np.full(k, s.lead_ms) if s.segment_lead_ms is None else s.segment_lead_ms
-                         ).attrs["units"] = "ms: each segment's forces switch on this long before its sound"
-        g.create_dataset("press", data=np.ones(k) if s.press is None else s.press
-                         ).attrs["units"] = "factor on the solved target's tongue-muscle forces"
+        g.create_dataset("lead", data=s.segment_lead_ms).attrs["units"] = ("ms: each segment's forces switch on this "
+                                                                          "long before its sound")
+        g.create_dataset("press", data=s.press).attrs["units"] = "factor on the solved target's tongue-muscle forces"
         g.create_dataset("lip_area", data=np.array([a for a, _ in p.lips])).attrs["units"] = "cm^2"
         g.create_dataset("lip_length", data=np.array([b for _, b in p.lips])).attrs["units"] = "cm"
         names = sorted({m for f_ in p.forces_n for m in f_})
@@ -513,8 +511,8 @@ class Record:
     activation_ms: tuple[float, float]
     lead_ms: float = 0.0
     prepare_ms: float = 0.0
-    leads_ms: np.ndarray | None = None  # (K,) each segment's own lead
-    press: np.ndarray | None = None  # (K,) each segment's tongue-force factor
+    leads_ms: np.ndarray = field(default_factory=lambda: np.zeros(0))  # (K,) each segment's own lead
+    press: np.ndarray = field(default_factory=lambda: np.zeros(0))  # (K,) each segment's tongue-force factor
 
 
 def read(path: Path | str) -> Record:
@@ -534,8 +532,10 @@ def read(path: Path | str) -> Record:
                           activation_ms=tuple(float(v) for v in g.attrs.get("activation_ms", (0.0, 0.0))),
                           lead_ms=float(g.attrs.get("lead_ms", 0.0)),
                           prepare_ms=float(g.attrs.get("prepare_ms", g.attrs.get("lead_ms", 0.0))),
-                          leads_ms=g["lead"][()] if "lead" in g else None,
-                          press=g["press"][()] if "press" in g else None)
+                          # records from before segments had their own lead and press: the utterance's, none
+                          leads_ms=g["lead"][()] if "lead" in g else np.full(len(g["label"]),
+                                                                             float(g.attrs.get("lead_ms", 0.0))),
+                          press=g["press"][()] if "press" in g else np.ones(len(g["label"])))
         except (KeyError, ValueError, OSError) as err:
             raise ArticError(f"{path} is damaged or incomplete ({type(err).__name__}); {STAGE.hint}") from None
 
