@@ -836,6 +836,8 @@ def speak_cmd(
     out: Optional[Path] = typer.Option(None, "--out", help="Sound to write (WAV); the TextGrid and NAME.h5 go "
                                                            "beside it (default data/utterances/NAME.wav)."),
     maps: Path = typer.Option(Path("data/epmaps.h5"), "--maps", help="EP maps the targets are solved on."),
+    dynamic: Path = typer.Option(Path("data/dynamic.h5"), "--dynamic", help="Dynamic map, for targets at a jaw "
+                                 "position without nets (used when the file exists)."),
     acoustic_maps: Path = typer.Option(Path("data/acoustic_maps.h5"), "--acoustic-maps",
                                        help="Formants of every EP (vowel targets)."),
     mesh: Path = typer.Option(Path("data/mesh.h5"), "--mesh", help="Mesh from 'artic build-mesh'."),
@@ -862,7 +864,8 @@ def speak_cmd(
             raise ArticError(f"{opt} {p}: give a {ext} file in an existing folder")
     say = lambda m: err_console.print(m, highlight=False)  # noqa: E731
     res = _with_progress("simulating", lambda update: speak_stage.speak(
-        utterance, out, maps, mesh, acoustic_maps, config, solutions, accept_nearest, budget, update, say, jobs))
+        utterance, out, maps, mesh, acoustic_maps, config, solutions, accept_nearest, budget, update, say, jobs,
+        dynamic))
     if res.up_to_date:
         out_console.print(f"{res.paths['wav']} is up to date (same utterance, solutions, mesh, config and code)",
                           highlight=False)

@@ -26,6 +26,7 @@ from ..acoustics.aerodynamics import turbulence
 from ..acoustics.tube import Tube
 from ..config import Config, load_config
 from ..control.course import activated, course, pulse_step
+from ..control.equilibrium import canonical
 from ..control.solver import TargetSpec, parse_target
 from ..control.targets import load_target
 from ..errors import ArticError, NotPhysical, UnreachableTarget
@@ -132,9 +133,10 @@ def plan(u: Utterance, cfg: Config, source: Path | str | None = None, maps: Path
          config: Path | str | None = None, solutions: Path | str = "data/utterances/solutions",
          accept_nearest: bool = False, budget: int = 8,
          say: Callable[[str], None] | None = None, targets: list[TargetSpec | None] | None = None,
-         jobs: int = 1) -> Plan:
+         jobs: int = 1, dynamic: Path | str | None = "data/dynamic.h5") -> Plan:
     """Solve every segment's target (cached; distinct targets in ``jobs`` processes) and collect the forces,
-    lips and voicing of each segment."""
+    lips and voicing of each segment.  ``dynamic`` carries the typical map to a target's jaw position that was
+    not mapped with nets (read only for such a target)."""
     targets = _targets(u, source, cfg.muscles.max_force_n) if targets is None else targets
     vt = vt_stage.speaker_tract(cfg)
     default_lips = (float(vt.lips.area_cm2), float(vt.lips.length_cm))
@@ -142,7 +144,8 @@ def plan(u: Utterance, cfg: Config, source: Path | str | None = None, maps: Path
     for k, t in enumerate(targets):
         if t is not None:
             distinct.setdefault(digest(t.model_dump(mode="json")), (k, t))
-    args = (maps, mesh, acoustic_maps, config, str(solutions), accept_nearest, budget)
+    args = (maps, mesh, acoustic_maps, config, str(solutions), accept_nearest, budget,
+            str(dynamic) if dynamic is not None and needs_dynamic(targets, cfg) else None)
     if jobs > 1 and len(distinct) > 1:
         from joblib import Parallel, delayed
 
@@ -182,12 +185,21 @@ def plan(u: Utterance, cfg: Config, source: Path | str | None = None, maps: Path
                 notes=notes, solutions=files)
 
 
+def needs_dynamic(targets: list[TargetSpec | None], cfg: Config) -> bool:
+    """Whether a spatial target sits at a jaw position the config's maps hold no nets for (the dynamic map then
+    carries the typical map there)."""
+    netted = [canonical(cfg.epmap.jaw_positions[n]) for n in cfg.epmap.net_jaw_positions
+              if n in cfg.epmap.jaw_positions]
+    return any(t is not None and t.acoustic is None and
+               (t.jaw.forces_n is None or canonical(dict(t.jaw.forces_n)) not in netted) for t in targets)
+
+
 def _solve_together(items: list[tuple[int, TargetSpec]], maps, mesh, acoustic_maps, config, folder: str,
-                    accept_nearest: bool, budget: int) -> list[tuple]:
+                    accept_nearest: bool, budget: int, dynamic: str | None = None) -> list[tuple]:
     """Solve targets in this process, the maps and simulators loaded once: (forces, how, path, messages) each."""
     if not items:
         return []
-    ctx = solve_stage.load_context(maps, None, mesh)
+    ctx = solve_stage.load_context(maps, dynamic, mesh)
     sim = voicer = None
     if any(t.acoustic is not None for _, t in items):
         solve_stage.add_formants(ctx, maps, mesh, config, acoustic_maps)
@@ -559,10 +571,12 @@ def _check_out(out: Path | str) -> Path:
 def speak(utterance: Path | str, out: Path | str | None = None, maps: Path | str = "data/epmaps.h5",
           mesh: Path | str = "data/mesh.h5", acoustic_maps: Path | str | None = "data/acoustic_maps.h5",
           config: Path | str | None = None, solutions: Path | str | None = None, accept_nearest: bool = False,
-          budget: int = 8, progress=None, say: Callable[[str], None] | None = None, jobs: int = 1) -> SpeakResult:
+          budget: int = 8, progress=None, say: Callable[[str], None] | None = None, jobs: int = 1,
+          dynamic: Path | str | None = "data/dynamic.h5") -> SpeakResult:
     """Speak an utterance file: WAV, TextGrid and HDF5 (``out``: the WAV; default data/utterances/NAME.wav).
     A record that already holds this recipe (the utterance, its targets' solutions, mesh, config, code) is
-    left alone."""
+    left alone.  ``dynamic``: the dynamic map, for targets at jaw positions the maps hold no nets for (read
+    only for such a target)."""
     u = load_utterance(utterance)
     cfg = load_config(config)
     out = _check_out(out if out is not None else Path("data/utterances") / f"{u.name}.wav")
@@ -574,6 +588,8 @@ def speak(utterance: Path | str, out: Path | str | None = None, maps: Path | str
               "targets": [None if t is None else digest(t.model_dump(mode="json")) for t in targets]}
     if any(t is not None for t in targets):
         inputs["epmaps"] = stored_content_hash(maps) or ""
+        if dynamic is not None and needs_dynamic(targets, cfg):
+            inputs["dynamic"] = stored_content_hash(dynamic) or ""
         if any(t is not None and t.acoustic is not None for t in targets):
             inputs["acoustic_maps"] = (stored_content_hash(acoustic_maps) or "") if acoustic_maps is not None else ""
     prov = STAGE.provenance(cfg, inputs=inputs, params={"accept_nearest": accept_nearest, "budget": budget})
@@ -582,7 +598,8 @@ def speak(utterance: Path | str, out: Path | str | None = None, maps: Path | str
         return SpeakResult(paths, None, up_to_date=True)
     model = sim_stage.build(cfg, m.mesh, m.wall)
     check_forces(u, list(model.drivable()), str(utterance))
-    p = plan(u, cfg, utterance, maps, mesh, acoustic_maps, config, folder, accept_nearest, budget, say, targets, jobs)
+    p = plan(u, cfg, utterance, maps, mesh, acoustic_maps, config, folder, accept_nearest, budget, say, targets, jobs,
+             dynamic)
     s = compute(u, p, cfg, m.mesh, m.wall, progress, model)
     return SpeakResult(write(out, s, prov), s)
 

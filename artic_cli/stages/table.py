@@ -72,9 +72,10 @@ STAGES: tuple[StageEntry, ...] = (
                                "configs/targets/vowels/{name}.yaml", "--out {figure}", "artic_cli.plots.solution",
                                ("configs/targets/vowels/{name}.yaml",)),)),
     StageEntry("utterances", "artic_cli.stages.speak", "{out}/utterances/{name}.h5",
-               "speak configs/utterances/{name}.yaml --maps {maps} --mesh {mesh} --config {config} "
-               "--acoustic-maps {out}/acoustic_maps.h5 --accept-nearest --out {out}/utterances/{name}.wav",
-               inputs=(MAPS, MESH, "{out}/acoustic_maps.h5", "configs/utterances/{name}.yaml",
+               "speak configs/utterances/{name}.yaml --maps {maps} --dynamic {dynamic} --mesh {mesh} "
+               "--config {config} --acoustic-maps {out}/acoustic_maps.h5 --accept-nearest "
+               "--out {out}/utterances/{name}.wav",
+               inputs=(MAPS, DYN, MESH, "{out}/acoustic_maps.h5", "configs/utterances/{name}.yaml",
                        "$(wildcard configs/targets/vowels/*.yaml configs/targets/consonants/*.yaml)"),
                items="utterances",
                figures=(Figure("{report}/utterance_{name}.png", "plot utterance {output}", "--out {figure}",
