@@ -164,6 +164,58 @@ def test_a_velar_stop_closes_on_the_palate_silently_then_bursts(tmp_path, mesh_f
     assert m["peak_speed_cm_s"]["dorsum"] <= 48.0
 
 
+A_ALVEOLAR = {"forces_n": {"GGm": 1.5, "JO": 4.0}, "label": "a"}  # a_alveolar.yaml as solved: jaw less open
+
+
+def test_a_laminal_stop_seals_the_blade_on_the_ridge_silently(tmp_path, mesh_file):
+    """/ata/ as configs/utterances/ata.yaml speaks it: /t/'s transversus and GGp with the jaw raised (JC 1.5 N)
+    seal the blade on the alveolar ridge within the segment: one closure of 40-120 ms, >= 30 dB below the
+    vowels, behind the incisors (not between them), the tip no faster than EMA's 40 cm/s + 50 %."""
+    doc = {"name": "ata", "f0_hz": [[0.0, 125], [0.63, 100]],
+           "segments": [dict(A_ALVEOLAR, duration_ms=280),
+                        {"forces_n": {"JC": 1.5, "GGp": 6.0, "T": 8.0}, "duration_ms": 90, "voiced": False,
+                         "label": "t", "lead_ms": 150},
+                        dict(A_ALVEOLAR, duration_ms=260, lead_ms=40)]}
+    res = _run("speak", _write(tmp_path / "ata.yaml", doc), "--mesh", mesh_file, "--out", tmp_path / "ata.wav")
+    assert res.exit_code == 0, res.output
+    rec = speak.read(tmp_path / "ata.h5")
+    y, rate = read_wav(tmp_path / "ata.wav")
+    m = speak.measures(rec, y, rate)
+    assert len(m["closures"]) == 1, m["closures"]
+    (c,) = m["closures"]
+    assert 40 <= c["duration_ms"] <= 120 and 0.27 <= c["start_s"] <= 0.33
+    vowel_db = np.mean([s["level_db"] for s in m["segments"] if s["label"] == "a"])
+    assert c["level_db"] < vowel_db - 30
+    closed = rec.area_cm2.min(axis=1) <= 0
+    behind = rec.length_cm[closed][:, ::-1].cumsum(axis=1)[:, ::-1]  # each section's distance from the lips' end
+    where = behind[np.arange(closed.sum()), np.argmin(rec.area_cm2[closed], axis=1)]
+    assert where.min() > 2.0, where  # the lips 1 cm, the incisors' section 0.15 cm: the closure is the tongue's
+    assert m["peak_speed_cm_s"]["tip"] <= 60.0 and m["peak_speed_cm_s"]["jaw"] <= 18.0
+    assert rec.attrs["max_beyond_wall_cm"] <= 0.01 and np.nanmax(np.abs(rec.volume_change)) <= 0.003
+
+
+def test_an_alveolar_channel_makes_s_frication_20_db_above_the_vowels(tmp_path, mesh_file):
+    """/asa/ as configs/utterances/asa.yaml speaks it, /s/'s forces as solved (T-SL 1.94 N + GGp 4.91 N, JC 1.5 N):
+    a channel of about 0.1 cm^2 behind the incisors for the whole /s/, no closure, and the sound above 3 kHz
+    during it at least 20 dB above the vowels' (the utterances issue's goal)."""
+    doc = {"name": "asa", "f0_hz": [[0.0, 125], [0.7, 100]],
+           "segments": [dict(A_ALVEOLAR, duration_ms=280),
+                        {"forces_n": {"JC": 1.5, "T-SL": 1.9416, "GGp": 4.9109}, "duration_ms": 150,
+                         "voiced": False, "label": "s", "lead_ms": 150},
+                        dict(A_ALVEOLAR, duration_ms=270, lead_ms=40)]}
+    res = _run("speak", _write(tmp_path / "asa.yaml", doc), "--mesh", mesh_file, "--out", tmp_path / "asa.wav")
+    assert res.exit_code == 0, res.output
+    rec = speak.read(tmp_path / "asa.h5")
+    y, rate = read_wav(tmp_path / "asa.wav")
+    m = speak.measures(rec, y, rate)
+    assert m["closures"] == []
+    s_ = next(s for s in m["segments"] if s["label"] == "s")
+    during = (rec.time_s >= 0.28) & (rec.time_s < 0.43)
+    assert 0.02 <= rec.area_cm2[during].min() and rec.area_cm2[during].min(axis=1).max() <= 0.3
+    vowels = np.mean([s["level_above_3khz_db"] for s in m["segments"] if s["label"] == "a"])
+    assert s_["level_above_3khz_db"] >= vowels + 20
+
+
 def test_a_narrow_channel_makes_frication_that_the_noise_switch_removes(spoken, mesh_file, tmp_path):
     rec = speak.read(spoken / "lab.h5")
     y, rate = read_wav(spoken / "lab.wav")
