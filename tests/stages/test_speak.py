@@ -391,6 +391,13 @@ def test_an_unreachable_target_exits_3_naming_its_segment_and_writes_nothing(tmp
     from PIL import Image
 
     assert Image.open(tmp_path / "u.gif").n_frames == 29  # every 5-ms frame of 140 ms, and the start
+    # a place target at a jaw position the maps hold no nets for needs the dynamic map (read only then)
+    opened = dict(far, name="opened", jaw={"forces_n": {"JO": 1.0}})
+    v = _write(tmp_path / "v.yaml", {"name": "v", "segments": [{"target": opened, "duration_ms": 60}]})
+    res = _run("speak", v, "--mesh", mesh_file, "--maps", tmp_path / "maps.h5", "--config", cfg, "--out",
+               tmp_path / "v" / "v.wav", "--solutions", tmp_path / "sol", "--dynamic", tmp_path / "none.h5")
+    assert res.exit_code == 2 and "need the dynamic map" in res.output and "artic dynamic-map" in res.output
+    assert len(res.output.strip().splitlines()) == 1 and not (tmp_path / "v").exists()
     rec = speak.read(tmp_path / "out" / "u.h5")
     assert rec.how == ["forces given", "unreachable: nearest answer", "unreachable: nearest answer"]
     # the nearest answer aims at the nearest reachable point the unreachable answer names, with the tolerance kept
