@@ -836,8 +836,8 @@ def speak_cmd(
     out: Optional[Path] = typer.Option(None, "--out", help="Sound to write (WAV); the TextGrid and NAME.h5 go "
                                                            "beside it (default data/utterances/NAME.wav)."),
     maps: Path = typer.Option(Path("data/epmaps.h5"), "--maps", help="EP maps the targets are solved on."),
-    dynamic: Path = typer.Option(Path("data/dynamic.h5"), "--dynamic", help="Dynamic map, for targets at a jaw "
-                                 "position without nets (used when the file exists)."),
+    dynamic: Path = typer.Option(Path("data/dynamic.h5"), "--dynamic", help="Dynamic map, read only for a place "
+                                 "target at a jaw position the maps hold no nets for."),
     acoustic_maps: Path = typer.Option(Path("data/acoustic_maps.h5"), "--acoustic-maps",
                                        help="Formants of every EP (vowel targets)."),
     mesh: Path = typer.Option(Path("data/mesh.h5"), "--mesh", help="Mesh from 'artic build-mesh'."),
