@@ -138,26 +138,37 @@ def test_a_closure_is_silent_and_its_release_makes_a_burst(spoken):
     assert np.all(np.isnan(rec.formants_hz[(rec.time_s > c["start_s"] + 0.01) & (rec.time_s < c["end_s"] - 0.01)]))
 
 
+def _vcv(tmp_path, mesh_file, name: str, f0_end_s: float, vowel: dict, first_ms: float, consonant: dict,
+         last_ms: float):
+    """Speak vowel-consonant-vowel (the forces given; the second vowel 40 ms ahead): record, sound, measures."""
+    doc = {"name": name, "f0_hz": [[0.0, 125], [f0_end_s, 100]],
+           "segments": [dict(vowel, duration_ms=first_ms), dict(consonant, voiced=False),
+                        dict(vowel, duration_ms=last_ms, lead_ms=40)]}
+    res = _run("speak", _write(tmp_path / f"{name}.yaml", doc), "--mesh", mesh_file, "--out", tmp_path / f"{name}.wav")
+    assert res.exit_code == 0, res.output
+    rec = speak.read(tmp_path / f"{name}.h5")
+    y, rate = read_wav(tmp_path / f"{name}.wav")
+    return rec, y, rate, speak.measures(rec, y, rate)
+
+
+def _one_stop_closure(m: dict, earliest_s: float, latest_s: float) -> dict:
+    """The utterance's only closure: 40-120 ms long, starting in the given window, >= 30 dB below the vowels."""
+    assert len(m["closures"]) == 1, m["closures"]
+    (c,) = m["closures"]
+    assert 40 <= c["duration_ms"] <= 120 and earliest_s <= c["start_s"] <= latest_s
+    vowel_db = np.mean([s["level_db"] for s in m["segments"] if s["label"] == "a"])
+    assert c["level_db"] < vowel_db - 30
+    return c
+
+
 def test_a_velar_stop_closes_on_the_palate_silently_then_bursts(tmp_path, mesh_file):
     """/aka/ as configs/utterances/aka.yaml times it, the forces given: /a/'s as solved (GGp 0.54 N, JO 6 N),
     /k/'s as solved (GGp 2 N + SG 1.89 N, JO 0.5 N) pressed by 1.3; the tongue on the palate closes the tract
     (contact read as closure), the closure is silent (no clicks as it slides) and its release bursts."""
     a = {"forces_n": {"GGp": 0.54, "JO": 6.0}, "label": "a"}
-    doc = {"name": "aka", "f0_hz": [[0.0, 125], [0.6, 100]],
-           "segments": [dict(a, duration_ms=250),
-                        {"forces_n": {"GGp": 2.6, "SG": 2.457, "JO": 0.5}, "duration_ms": 90, "voiced": False,
-                         "label": "k", "lead_ms": 130},
-                        dict(a, duration_ms=260, lead_ms=40)]}
-    res = _run("speak", _write(tmp_path / "aka.yaml", doc), "--mesh", mesh_file, "--out", tmp_path / "aka.wav")
-    assert res.exit_code == 0, res.output
-    rec = speak.read(tmp_path / "aka.h5")
-    y, rate = read_wav(tmp_path / "aka.wav")
-    m = speak.measures(rec, y, rate)
-    assert len(m["closures"]) == 1, m["closures"]
-    (c,) = m["closures"]
-    assert 40 <= c["duration_ms"] <= 120 and 0.23 <= c["start_s"] <= 0.27
-    vowel_db = np.mean([s["level_db"] for s in m["segments"] if s["label"] == "a"])
-    assert c["level_db"] < vowel_db - 30
+    k = {"forces_n": {"GGp": 2.6, "SG": 2.457, "JO": 0.5}, "duration_ms": 90, "label": "k", "lead_ms": 130}
+    rec, y, rate, m = _vcv(tmp_path, mesh_file, "aka", 0.6, a, 250, k, 260)
+    c = _one_stop_closure(m, 0.23, 0.27)
     burst = band_level_db(y, rate, c["end_s"], c["end_s"] + 0.015, 3000.0)
     assert burst > band_level_db(y, rate, c["start_s"] + 0.01, c["end_s"] - 0.01, 3000.0) + 40
     assert rec.attrs["max_beyond_wall_cm"] <= 0.01 and np.nanmax(np.abs(rec.volume_change)) <= 0.003
@@ -171,21 +182,9 @@ def test_a_laminal_stop_seals_the_blade_on_the_ridge_silently(tmp_path, mesh_fil
     """/ata/ as configs/utterances/ata.yaml speaks it: /t/'s transversus and GGp with the jaw raised (JC 1.5 N)
     seal the blade on the alveolar ridge within the segment: one closure of 40-120 ms, >= 30 dB below the
     vowels, behind the incisors (not between them), the tip no faster than EMA's 40 cm/s + 50 %."""
-    doc = {"name": "ata", "f0_hz": [[0.0, 125], [0.63, 100]],
-           "segments": [dict(A_ALVEOLAR, duration_ms=280),
-                        {"forces_n": {"JC": 1.5, "GGp": 6.0, "T": 8.0}, "duration_ms": 90, "voiced": False,
-                         "label": "t", "lead_ms": 150},
-                        dict(A_ALVEOLAR, duration_ms=260, lead_ms=40)]}
-    res = _run("speak", _write(tmp_path / "ata.yaml", doc), "--mesh", mesh_file, "--out", tmp_path / "ata.wav")
-    assert res.exit_code == 0, res.output
-    rec = speak.read(tmp_path / "ata.h5")
-    y, rate = read_wav(tmp_path / "ata.wav")
-    m = speak.measures(rec, y, rate)
-    assert len(m["closures"]) == 1, m["closures"]
-    (c,) = m["closures"]
-    assert 40 <= c["duration_ms"] <= 120 and 0.27 <= c["start_s"] <= 0.33
-    vowel_db = np.mean([s["level_db"] for s in m["segments"] if s["label"] == "a"])
-    assert c["level_db"] < vowel_db - 30
+    t = {"forces_n": {"JC": 1.5, "GGp": 6.0, "T": 8.0}, "duration_ms": 90, "label": "t", "lead_ms": 150}
+    rec, y, rate, m = _vcv(tmp_path, mesh_file, "ata", 0.63, A_ALVEOLAR, 280, t, 260)
+    _one_stop_closure(m, 0.27, 0.33)
     closed = rec.area_cm2.min(axis=1) <= 0
     behind = rec.length_cm[closed][:, ::-1].cumsum(axis=1)[:, ::-1]  # each section's distance from the lips' end
     where = behind[np.arange(closed.sum()), np.argmin(rec.area_cm2[closed], axis=1)]
@@ -198,16 +197,8 @@ def test_an_alveolar_channel_makes_s_frication_20_db_above_the_vowels(tmp_path, 
     """/asa/ as configs/utterances/asa.yaml speaks it, /s/'s forces as solved (T-SL 1.94 N + GGp 4.91 N, JC 1.5 N):
     a channel of about 0.1 cm^2 behind the incisors for the whole /s/, no closure, and the sound above 3 kHz
     during it at least 20 dB above the vowels' (the utterances issue's goal)."""
-    doc = {"name": "asa", "f0_hz": [[0.0, 125], [0.7, 100]],
-           "segments": [dict(A_ALVEOLAR, duration_ms=280),
-                        {"forces_n": {"JC": 1.5, "T-SL": 1.9416, "GGp": 4.9109}, "duration_ms": 150,
-                         "voiced": False, "label": "s", "lead_ms": 150},
-                        dict(A_ALVEOLAR, duration_ms=270, lead_ms=40)]}
-    res = _run("speak", _write(tmp_path / "asa.yaml", doc), "--mesh", mesh_file, "--out", tmp_path / "asa.wav")
-    assert res.exit_code == 0, res.output
-    rec = speak.read(tmp_path / "asa.h5")
-    y, rate = read_wav(tmp_path / "asa.wav")
-    m = speak.measures(rec, y, rate)
+    fric = {"forces_n": {"JC": 1.5, "T-SL": 1.9416, "GGp": 4.9109}, "duration_ms": 150, "label": "s", "lead_ms": 150}
+    rec, y, rate, m = _vcv(tmp_path, mesh_file, "asa", 0.7, A_ALVEOLAR, 280, fric, 270)
     assert m["closures"] == []
     s_ = next(s for s in m["segments"] if s["label"] == "s")
     during = (rec.time_s >= 0.28) & (rec.time_s < 0.43)
