@@ -238,6 +238,7 @@ class MuscleFunctionSpec(Strict):
     drive_force_n: Positive = 4.0
     drive_ms: Positive = 150.0
     contact: bool = False  # the paper left the wall out of this study
+    hold_jaw: bool = False  # the mandible held at its rest while tongue muscles act (false: free, as the paper)
 
 
 class Cuboid(Strict):

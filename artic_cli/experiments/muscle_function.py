@@ -5,7 +5,8 @@ example GGp-GGm-GGa) held for 120 ms at every triple of six force levels
 (4 combinations x 6^3 = 864 starts).  From each start all forces are released
 and one muscle pulls at 4 N for 150 ms; the end points of the tip and the
 dorsum show where each muscle drives them whatever the start.  As in the
-paper the wall is left out (``muscle_function.contact``).
+paper the wall is left out (``muscle_function.contact``); the mandible is
+free, or held at its rest as the EP maps hold it (``muscle_function.hold_jaw``).
 
 Each distinct start force set is one task (its 120-ms run and the ten 150-ms
 drives; the combinations share muscles, so 864 starts are 726 distinct ones),
@@ -27,18 +28,23 @@ from ..control.equilibrium import control_for, watch_nodes
 from ..geometry.mesh import Mesh
 from ..geometry.wall import WallSurface
 from ..mechanics.model import ARTICULATOR_SECTIONS, Model, build_articulator
+from ..mechanics.jaw_hold import fresh_start, hold_jaw
 from ..mechanics.simulate import hold, settle
 
 _CACHE: dict[str, tuple[Model, object]] = {}
 
 
 def model_and_rest(key: str, cfg_json: str, mesh: Mesh, wall: WallSurface) -> tuple[Model, object]:
-    """The articulator (wall contact as ``muscle_function.contact`` says) and its rest, once per process."""
+    """The articulator (wall contact as ``muscle_function.contact`` says, the mandible held at its rest if
+    ``muscle_function.hold_jaw``) and its rest, once per process."""
     if key not in _CACHE:
         cfg = parse_config(json.loads(cfg_json), "<muscle-function config>")
         model = build_articulator(ConfigView(cfg, ARTICULATOR_SECTIONS), mesh, wall, contact=cfg.muscle_function.contact)
+        rest = settle(model)
+        if cfg.muscle_function.hold_jaw:
+            model, rest = hold_jaw(model, rest.x), fresh_start(rest)
         _CACHE.clear()
-        _CACHE[key] = (model, settle(model))
+        _CACHE[key] = (model, rest)
     return _CACHE[key]
 
 

@@ -46,7 +46,8 @@ def compute(cfg: Config, mesh, wall, mesh_sha: str, sweep: Sweep) -> tuple[Muscl
     check_spec(view)
     spec = view.muscle_function
     key = digest({"sections": sections_hash(view, ARTICULATOR_SECTIONS), "mesh": mesh_sha,
-                  "code": code_hash(PHYSICS), "contact": spec.contact})
+                  "code": code_hash(PHYSICS), "contact": spec.contact,
+                  "hold_jaw": spec.hold_jaw})
     cfg_json = json.dumps(view.full.model_dump(mode="json"))
     todo = starts(view)
     # combinations share muscles: a start whose other muscles are at zero recurs; each distinct one runs once
@@ -72,7 +73,8 @@ def write(path: Path | str, mf: MuscleFunction, cfg: Config, prov=None) -> None:
     with atomic_h5(path, STAGE.kind, prov) as f:
         f.attrs.update({"muscles": mf.muscles, "combinations": json.dumps(mf.combinations),
                         "drive_force_n": mf.drive_n, "drive_ms": mf.drive_ms, "start_ms": spec.start_ms,
-                        "contact": spec.contact, "control_points": ["tip", "dorsum", "jaw"],
+                        "contact": spec.contact, "hold_jaw": spec.hold_jaw,
+                        "control_points": ["tip", "dorsum", "jaw"],
                         "layout": "starts (S, point, xyz) cm; ends (muscle, S, point, xyz) cm; rest (point, xyz)"})
         for name, data, unit in (("combination", mf.combo, "index into attribute combinations"),
                                  ("start_forces", mf.start_forces, "N"), ("starts", mf.starts, "cm"),
