@@ -113,20 +113,44 @@ def top_force(jm: JawMaps) -> float:
                      for lv in net.levels))
 
 
+def trust_step(jac: np.ndarray, err: np.ndarray, radius: float) -> np.ndarray:
+    """The least-squares step for ``jac @ step = err``, damped (Levenberg-Marquardt) to at most ``radius``."""
+    u, sv, vt = np.linalg.svd(jac, full_matrices=False)
+    g = u.T @ err
+    keep = sv > 1e-12 * max(sv[0], 1e-300)
+
+    def step(mu: float) -> np.ndarray:
+        return vt[keep].T @ (sv[keep] * g[keep] / (sv[keep] ** 2 + mu))
+
+    full = step(0.0)
+    if np.linalg.norm(full) <= radius:
+        return full
+    lo, hi = 0.0, float(sv[0] ** 2 * max(1.0, np.linalg.norm(g) / (radius * sv[0])))  # |step(hi)| <= radius
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if np.linalg.norm(step(mid)) > radius else (lo, mid)
+    return step(hi)
+
+
 def broyden(measure, jac: np.ndarray, forces: dict[str, float], free: list[str], goal: np.ndarray, done,
             budget: int, first=None, upper: float = np.inf) -> Correction:
     """Quasi-Newton on the free forces (kept within 0..``upper`` N) until ``done(error, extra)``:
     ``measure(forces) -> (feature, extra)`` simulates; the first Jacobian is given (from the maps), later
-    ones come from Broyden's update."""
+    ones come from Broyden's update.  Each step starts from the best force set so far and is at most
+    ``radius`` N long (a trust region: first the force that would move the feature four times its error along
+    the Jacobian's strongest direction, doubled after a step that lowers the error, a quarter of the step after
+    one that does not), so a nearly singular map Jacobian cannot throw a close candidate far off."""
     forces = dict(forces)
     feat, extra = measure(forces) if first is None else first
     sims = 1 if first is None else 0
     err = goal - feat
     history = [{"forces_n": dict(forces), "error": float(np.linalg.norm(err))}]
     best = Correction(dict(forces), feat, extra, float(np.linalg.norm(err)), sims, history)
+    strongest = float(np.linalg.norm(jac, 2))
+    radius = MAX_STEP_N if strongest == 0.0 else min(MAX_STEP_N, 4.0 * best.error / strongest)
     while not done(best.error, best.extra) and sims < budget:
-        step, *_ = np.linalg.lstsq(jac, err, rcond=None)
-        step = np.clip(step, -MAX_STEP_N, MAX_STEP_N)
+        forces, feat, err = dict(best.forces), best.feature, goal - best.feature
+        step = np.clip(trust_step(jac, err, radius), -MAX_STEP_N, MAX_STEP_N)
         f = np.array([forces.get(m, 0.0) for m in free])
         new = np.clip(f + step, 0.0, upper)
         step = new - f
@@ -137,10 +161,13 @@ def broyden(measure, jac: np.ndarray, forces: dict[str, float], free: list[str],
         got, got_extra = measure(trial)
         sims += 1
         jac = jac + np.outer((got - feat) - jac @ step, step) / float(step @ step)  # Broyden
-        forces, feat, extra, err = trial, got, got_extra, goal - got
-        history.append({"forces_n": dict(forces), "error": float(np.linalg.norm(err))})
-        if np.linalg.norm(err) < best.error:
-            best = Correction(dict(forces), feat, extra, float(np.linalg.norm(err)), sims, history)
+        e = float(np.linalg.norm(goal - got))
+        history.append({"forces_n": dict(trial), "error": e})
+        if e < best.error:
+            best = Correction(dict(trial), got, got_extra, e, sims, history)
+            radius = min(2.0 * radius, MAX_STEP_N)
+        else:
+            radius = 0.25 * float(np.linalg.norm(step))
     best.simulations, best.history = sims, history
     return best
 

@@ -116,7 +116,7 @@ def run(model: Model, state: State, control_at: Callable[[float], Control], dura
     record_muscles(state, control_at(state.t).muscle_force if ms is not None else None)
     w = 0.0
     gravity = model.node_mass[:, None] * model.gravity
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     failure, done = None, 0
     with gc_paused():
         for k in range(1, n_steps + 1):
@@ -144,14 +144,15 @@ def run(model: Model, state: State, control_at: Callable[[float], Control], dura
                 proj.append(state.projected)
             if progress is not None:
                 progress(k, n_steps)
-    wall = time.perf_counter() - t0
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     x = np.array(xs)
     v = np.array(vs)
     vol, inv = frame_volumes(model, x)
     energy = mechanical_energy(model, x, v)
     traj = Trajectory(time=np.array(times), x=x, v=v, volume=vol, iterations=np.array(its),
                       energy=energy - energy[0], work=np.array(work), inverted=inv,
-                      stats={"steps": done, "dt": h, "wall_time_s": wall, "refactors": state.refactors,
+                      stats={"steps": done, "dt": h, "wall_time_s": wall, "cpu_time_s": cpu,
+                             "refactors": state.refactors,
                              "newton_iterations": int(np.sum(its)),
                              "diagnostics_time_s": time.perf_counter() - t0 - wall, "failure": failure},
                       contact_count=np.array([len(c) for c in c_nodes]),
