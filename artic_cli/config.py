@@ -143,7 +143,7 @@ class Muscles(Strict):
     groups: dict[str, dict[str, Positive]] = {
         "JO": {"lateral_pterygoid_upper": 0.25, "lateral_pterygoid_lower": 0.25, "anterior_digastric": 0.5},
         "JC": {"temporalis_anterior": 0.3, "temporalis_posterior": 0.2, "masseter": 0.3, "medial_pterygoid": 0.2},
-        "T-SL": {"T": 1.0, "SL": 1.0}}
+        "T-SL": {"T": 0.5, "SL": 0.5}}  # a group's force shared by its muscles (docs/modelling.md)
     # Steady force (N) of muscles or groups in every state, on top of the control: the jaw closers'
     # postural tone holds the mandible at its reference height against gravity.
     postural_tone_n: dict[str, NonNeg] = {"JC": 2.1}
