@@ -135,6 +135,8 @@ class Muscles(Strict):
     force_length_width: Annotated[float, Field(ge=1.0, le=5.0)] = 1.0
     # routing (docs/modelling.md): the verticalis over this many radial sections from the tip; IL also midsagittally
     verticalis_sections: Annotated[int, Field(ge=1)] = 4
+    # ... from the surface down to this concentric level (0: the GG tendon; the surface is the last level)
+    verticalis_to_level: Annotated[int, Field(ge=0)] = 3
     il_midsagittal: bool = False
     # SG's fibres in each parasagittal plane: from the styloid into the tongue at node (radial, level), then
     # forward along `level` from radial radials[0] to radials[1] (radial 0: the tip; level 0: the GG tendon)

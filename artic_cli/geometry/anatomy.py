@@ -85,14 +85,16 @@ def _landmark(cfg: Config, key: str):
 
 
 def build_body(cfg: Config, mesh: Mesh | None = None, *, digastric_through_sling: bool = False,
-               verticalis_sections: int = 4, il_midsagittal: bool = False, gg_tendon: str = "all",
+               verticalis_sections: int = 4, verticalis_to_level: int = 3, il_midsagittal: bool = False,
+               gg_tendon: str = "all",
                floor_on_mylohyoid: bool = False, sg_routes=None) -> Body:
     """The articulator's nodes, links and muscle routes.
 
     ``digastric_through_sling``: the anterior digastric's fibre goes on from the sling to the mastoid (a fixed
     segment that adds its length to the fibre's); ``verticalis_sections``: the verticalis spans this many radial
-    sections from the tip; ``il_midsagittal``: IL has a fibre in the midsagittal plane as well; ``gg_tendon``:
-    the mandible carries the tongue's GG tendon line in ``"all"`` three planes or the ``"midsagittal"`` one;
+    sections from the tip, from the surface down to concentric level ``verticalis_to_level``; ``il_midsagittal``:
+    IL has a fibre in the midsagittal plane as well; ``gg_tendon``: the mandible carries the tongue's GG tendon
+    line in ``"all"`` three planes or the ``"midsagittal"`` one;
     ``floor_on_mylohyoid``: the floor nodes are also linked to their two nearest mylohyoid points;
     ``sg_routes``: SG's fibres per side (``muscles.styloglossus`` items; None: that key's default)."""
     mesh = mesh if mesh is not None else tongue_mesh(cfg.speaker.tongue)
@@ -107,6 +109,9 @@ def build_body(cfg: Config, mesh: Mesh | None = None, *, digastric_through_sling
     if not 1 <= verticalis_sections <= nr - 1:
         raise ArticError(f"config: muscles.verticalis_sections is {verticalis_sections}; give 1 to {nr - 1} "
                          "(the tongue's radial sections)")
+    if not 0 <= verticalis_to_level <= nc - 2:
+        raise ArticError(f"config: muscles.verticalis_to_level is {verticalis_to_level}; give 0 to {nc - 2} "
+                         "(0: the GG tendon; the fibre needs two levels)")
     t = lambda k, j, p: int(tongue_node_index(k, j, p, nc - 1))  # noqa: E731
     b = _Builder(mesh)
     lm = lambda key: _landmark(cfg, key)  # noqa: E731
@@ -235,12 +240,12 @@ def build_body(cfg: Config, mesh: Mesh | None = None, *, digastric_through_sling
         fib["SL"].append(chain([t(k, nc - 2, p) for k in range(8, 0, -1)] + [t(0, nc - 1, p)]))
         if p != mid:
             for k in range(verticalis_sections):
-                fib["V"].append(chain([t(k, j, p) for j in range(nc - 1, 2, -1)]))
+                fib["V"].append(chain([t(k, j, p) for j in range(nc - 1, verticalis_to_level - 1, -1)]))
     for k in range(2, 8):
         for j in (nc - 3, nc - 2):
             fib["T"].append(chain([t(k, j, 0), t(k, j, mid), t(k, j, planes - 1)]))
     for k in range(verticalis_sections):  # front part of the tongue, dorsum down into the blade
-        fib["V"].append(chain([t(k, j, mid) for j in range(nc - 1, 2, -1)]))
+        fib["V"].append(chain([t(k, j, mid) for j in range(nc - 1, verticalis_to_level - 1, -1)]))
 
     nodes = np.array(b.points)
     weights = {}

@@ -175,8 +175,24 @@ def closest_on_triangles(p: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndar
     return out
 
 
+def feature_normal(p: np.ndarray, q: np.ndarray, face: np.ndarray) -> np.ndarray:
+    """The wall's normal at closest points ``q`` (P, 3) of points ``p``: the direction from q to p, turned to
+    the side of the closest triangle's normal ``face`` (the same as it where q is inside the triangle).  Where
+    q lies on an edge or a corner the triangles meeting there give one normal, which turns continuously
+    as p moves round the edge; a triangle's own normal would jump between its neighbours', so that two
+    mirror-image points on either side of a seam could be pushed in directions that are not mirror images.
+    Points within FEATURE_EPS of the wall keep the triangle's normal."""
+    d = p - q
+    length = np.linalg.norm(d, axis=1)
+    sign = np.where((d * face).sum(axis=1) >= 0.0, 1.0, -1.0)
+    far = length > kernels.FEATURE_EPS
+    out = face.copy()
+    out[far] = sign[far, None] * d[far] / length[far, None]
+    return out
+
+
 def _nearest(cm: ContactModel, p: np.ndarray, grid: CandidateGrid):
-    """Closest wall point, its triangle normal and the signed distance along it (numpy)."""
+    """Closest wall point, the wall's normal there and the signed distance along it (numpy)."""
     q, n = np.empty_like(p), np.empty_like(p)
     for i, pi in enumerate(p):
         tris = grid.candidates(pi)
@@ -184,6 +200,7 @@ def _nearest(cm: ContactModel, p: np.ndarray, grid: CandidateGrid):
         near = closest_on_triangles(np.broadcast_to(pi, (len(tris), 3)), c[:, 0], c[:, 1], c[:, 2])
         best = np.argmin(((near - pi) ** 2).sum(axis=1))
         q[i], n[i] = near[best], cm.wall.normals[tris[best]]
+    n = feature_normal(p, q, n)
     return q, n, ((p - q) * n).sum(axis=1)
 
 

@@ -27,6 +27,8 @@ except ImportError:  # pragma: no cover
             return fn
         return wrap(args[0]) if args and callable(args[0]) else wrap
 
+FEATURE_EPS = 1e-6  # cm: closer to the wall than this, a point takes its closest triangle's own normal
+
 
 @njit(cache=True, fastmath=False)
 def cylinder_state(x, ci, cj, l0, area0, youngs, poisson, knee, rate, slack):
@@ -349,7 +351,8 @@ def grid_candidates(centres, tris, corners, slack):
 @njit(cache=True, fastmath=False)
 def _nearest_in_grid(p, grid, corners, normals, q, n):
     """Closest point q (3,) to p (3,) over the candidate triangles of p's voxel (all triangles outside the
-    grid; ``grid`` = :meth:`..contact.CandidateGrid.as_tuple`), and that triangle's normal n (3,)."""
+    grid; ``grid`` = :meth:`..contact.CandidateGrid.as_tuple`), and the wall's normal n (3,) there: the
+    direction from q to p, turned to the triangle normal's side (:func:`..contact.feature_normal`)."""
     lo, spacing, dims, offsets, cands, tris = grid
     cell = 0
     inside = True
@@ -368,6 +371,12 @@ def _nearest_in_grid(p, grid, corners, normals, q, n):
             best = d
             q[0], q[1], q[2] = q0, q1, q2
             n[0], n[1], n[2] = normals[t, 0], normals[t, 1], normals[t, 2]
+    d = np.sqrt(best)
+    if d > FEATURE_EPS:
+        s = (p[0] - q[0]) * n[0] + (p[1] - q[1]) * n[1] + (p[2] - q[2]) * n[2]
+        sign = 1.0 if s >= 0.0 else -1.0
+        for a in range(3):
+            n[a] = sign * (p[a] - q[a]) / d
 
 
 @njit(cache=True, fastmath=False)

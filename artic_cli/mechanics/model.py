@@ -380,7 +380,8 @@ def build_articulator(cfg: Config, mesh: Mesh, wall: WallSurface | None = None, 
                       gravity: float | None = None) -> Model:
     """Tongue, jaw and hyoid with all muscles, the condyle guide and (optionally) wall contact."""
     body = build_body(cfg, mesh, digastric_through_sling=cfg.jaw.digastric_through_sling,
-                      verticalis_sections=cfg.muscles.verticalis_sections, il_midsagittal=cfg.muscles.il_midsagittal,
+                      verticalis_sections=cfg.muscles.verticalis_sections,
+                      verticalis_to_level=cfg.muscles.verticalis_to_level, il_midsagittal=cfg.muscles.il_midsagittal,
                       gg_tendon=cfg.jaw.gg_tendon, floor_on_mylohyoid=cfg.jaw.floor_on_mylohyoid,
                       sg_routes=cfg.muscles.styloglossus)
     n = len(body.nodes)

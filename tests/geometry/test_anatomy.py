@@ -44,6 +44,19 @@ def test_verticalis_extent_and_a_midsagittal_il_follow_the_config(cfg):
         build_body(cfg, verticalis_sections=11)
 
 
+def test_verticalis_depth_follows_the_config(cfg):
+    """Each verticalis fibre runs down its radial line from the surface to muscles.verticalis_to_level."""
+    nc = cfg.speaker.tongue.concentric_sections
+    for level in (3, 1):
+        body = build_body(cfg, verticalis_to_level=level)
+        assert all(len(f) == nc - level + 1 for f in body.fibres["V"])
+        r = np.linalg.norm(body.nodes[[f[-1] for f in body.fibres["V"]], :2] - cfg.speaker.tongue.gg_origin_cm, axis=1)
+        top = np.linalg.norm(body.nodes[[f[0] for f in body.fibres["V"]], :2] - cfg.speaker.tongue.gg_origin_cm, axis=1)
+        assert np.all(r < top)  # downward, toward the GG origin
+    with pytest.raises(ArticError, match="muscles.verticalis_to_level"):
+        build_body(cfg, verticalis_to_level=nc)
+
+
 def test_the_mandible_carries_the_gg_tendon_in_every_plane_or_in_the_midline_only(cfg):
     every, mid = build_body(cfg), build_body(cfg, gg_tendon="midsagittal")
     anchor = every.mesh.node_sets["anchor"]

@@ -87,3 +87,28 @@ def test_compiled_candidate_grid_lists_the_numpy_candidates(art):
     assert np.array_equal(grids[False].cands, grids[True].cands)
     assert 3 < len(grids[True].cands) / (len(grids[True].offsets) - 1) < 60  # a real short list per voxel
 
+
+
+def test_the_wall_normal_turns_smoothly_round_a_seam_and_mirrors(art):
+    """Points beyond the palate on either side of the wall's parasagittal seam (z = +-0.7 cm), mirror images of
+    each other, get mirror-image normals, and the normal turns continuously as a point crosses the seam (the
+    two triangles' own normals differ by 16 deg there); the signed gap is the distance to the wall."""
+    from artic_cli.mechanics import contact
+
+    cm = art.contact
+    p = np.array([[-2.932, 1.70, z] for z in np.linspace(0.60, 0.80, 81)])  # 0.0025 cm apart across z = 0.7
+    both = np.vstack([p, p * [1.0, 1.0, -1.0]])
+    x = np.vstack([art.rest, both])
+    idx = np.arange(len(art.rest), len(x))
+    for flag in (True, False):
+        elements.USE_KERNELS = flag
+        try:
+            q, n, g, _ = contact.wall_query(cm, x, idx)
+        finally:
+            elements.USE_KERNELS = True
+        a, b = n[:len(p)], n[len(p):]
+        assert np.allclose(b, a * [1.0, 1.0, -1.0], atol=1e-9)  # mirror points, mirror normals
+        assert np.allclose(np.linalg.norm(n, axis=1), 1.0)
+        steps = np.degrees(np.arccos(np.clip((a[1:] * a[:-1]).sum(axis=1), -1.0, 1.0)))
+        assert np.degrees(np.arccos(a[0] @ a[-1])) > 10.0 and steps.max() < 3.0  # it turns, without a jump
+        assert (g > 0).all() and np.allclose(g, np.linalg.norm(x[idx] - q, axis=1), atol=1e-12)
