@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Annotated, Literal
 
 import yaml
-from pydantic import Field, ValidationError, field_validator
+from pydantic import Field, ValidationError, field_validator, model_validator
 
 from .errors import ArticError
 from .validation import DEFAULT_MAX_FORCE_N, Finite, Point2, Point3, Strict, describe, increasing, parse
@@ -109,6 +109,21 @@ class Simulation(Strict):
     mirror_symmetry: bool = False
 
 
+class InferiorLongitudinalis(Strict):
+    """IL's fibre in each plane: from node (radial, level) ``start`` up its radial line to ``level``, forward
+    along that concentric level to radial 1, then up the tip's radial line to the tip."""
+
+    start: tuple[Annotated[int, Field(ge=1)], Annotated[int, Field(ge=0)]] = (10, 2)
+    level: Annotated[int, Field(ge=0)] = 2
+
+    @model_validator(mode="after")
+    def _start_below_level(self):
+        if self.start[1] > self.level:
+            raise ValueError(f"start level {self.start[1]} lies above the level {self.level} IL runs along; "
+                             "give a start level at or below it")
+        return self
+
+
 class StyloglossusFibre(Strict):
     entry: tuple[Annotated[int, Field(ge=0)], Annotated[int, Field(ge=0)]]  # (radial, level) where it enters the tongue
     level: Annotated[int, Field(ge=0)]  # the concentric level it runs along
@@ -138,6 +153,7 @@ class Muscles(Strict):
     # ... from the surface down to this concentric level (0: the GG tendon; the surface is the last level)
     verticalis_to_level: Annotated[int, Field(ge=0)] = 3
     il_midsagittal: bool = False
+    inferior_longitudinalis: InferiorLongitudinalis = InferiorLongitudinalis()
     # SG's fibres in each parasagittal plane: from the styloid into the tongue at node (radial, level), then
     # forward along `level` from radial radials[0] to radials[1] (radial 0: the tip; level 0: the GG tendon)
     styloglossus: Annotated[list[StyloglossusFibre], Field(min_length=1)] = [

@@ -86,20 +86,26 @@ def _landmark(cfg: Config, key: str):
 
 def build_body(cfg: Config, mesh: Mesh | None = None, *, digastric_through_sling: bool = False,
                verticalis_sections: int = 4, verticalis_to_level: int = 3, il_midsagittal: bool = False,
-               gg_tendon: str = "all",
+               il_route=None, gg_tendon: str = "all",
                floor_on_mylohyoid: bool = False, sg_routes=None) -> Body:
     """The articulator's nodes, links and muscle routes.
 
     ``digastric_through_sling``: the anterior digastric's fibre goes on from the sling to the mastoid (a fixed
     segment that adds its length to the fibre's); ``verticalis_sections``: the verticalis spans this many radial
     sections from the tip, from the surface down to concentric level ``verticalis_to_level``; ``il_midsagittal``:
-    IL has a fibre in the midsagittal plane as well; ``gg_tendon``: the mandible carries the tongue's GG tendon
+    IL has a fibre in the midsagittal plane as well; ``il_route``: IL's path (``muscles.inferior_longitudinalis``;
+    None: that key's default); ``gg_tendon``: the mandible carries the tongue's GG tendon
     line in ``"all"`` three planes or the ``"midsagittal"`` one;
     ``floor_on_mylohyoid``: the floor nodes are also linked to their two nearest mylohyoid points;
     ``sg_routes``: SG's fibres per side (``muscles.styloglossus`` items; None: that key's default)."""
     mesh = mesh if mesh is not None else tongue_mesh(cfg.speaker.tongue)
     nr, nc, planes = mesh.grid
     sg_routes = Muscles().styloglossus if sg_routes is None else sg_routes
+    il_route = Muscles().inferior_longitudinalis if il_route is None else il_route
+    (il_k, il_j), il_level = il_route.start, il_route.level
+    if il_k > nr - 1 or il_level > nc - 2:
+        raise ArticError(f"config: muscles.inferior_longitudinalis leaves the tongue (start radial {il_k}, level "
+                         f"{il_level}); radials run 1-{nr - 1} and levels 0-{nc - 2}")
     for i, route in enumerate(sg_routes):
         for name, (k, j) in (("entry", route.entry), ("radials", (route.radials[0], route.level)),
                              ("radials", (route.radials[1], route.level))):
@@ -220,7 +226,8 @@ def build_body(cfg: Config, mesh: Mesh | None = None, *, digastric_through_sling
             fib["SG"].append(chain([styloid[s], t(ke, je, p)] + [t(k, route.level, p) for k in range(k0, k1 - 1, -1)]))
     # lower side, root to tip, in the parasagittal planes (between GG and HG) and optionally the midsagittal one
     for p in (*sides, mid) if il_midsagittal else sides:
-        fib["IL"].append(chain([t(k, 2, p) for k in range(last, 0, -1)] + [t(0, j, p) for j in range(3, nc)]))
+        fib["IL"].append(chain([t(il_k, j, p) for j in range(il_j, il_level)] + [t(k, il_level, p) for k in range(
+            il_k, 0, -1)] + [t(0, j, p) for j in range(il_level + 1, nc)]))
     for s, p in enumerate(sides):
         fib["MH"].append(chain([myl_front[s], t(last, 1, mid)]))
         fib["MH"].append(chain([myl_mid[s], t(last, 3, mid)]))

@@ -382,6 +382,7 @@ def build_articulator(cfg: Config, mesh: Mesh, wall: WallSurface | None = None, 
     body = build_body(cfg, mesh, digastric_through_sling=cfg.jaw.digastric_through_sling,
                       verticalis_sections=cfg.muscles.verticalis_sections,
                       verticalis_to_level=cfg.muscles.verticalis_to_level, il_midsagittal=cfg.muscles.il_midsagittal,
+                      il_route=cfg.muscles.inferior_longitudinalis,
                       gg_tendon=cfg.jaw.gg_tendon, floor_on_mylohyoid=cfg.jaw.floor_on_mylohyoid,
                       sg_routes=cfg.muscles.styloglossus)
     n = len(body.nodes)

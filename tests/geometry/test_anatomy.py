@@ -107,3 +107,22 @@ def test_styloglossus_follows_its_configured_routes(cfg, mesh):
         build_body(cfg, mesh, sg_routes=[StyloglossusFibre(entry=(nr, 2), level=2, radials=(3, 1))])
     with pytest.raises(ValueError, match="run backward"):
         StyloglossusFibre(entry=(7, 5), level=2, radials=(1, 6))
+
+
+def test_il_route_follows_the_config(cfg):
+    """IL from muscles.inferior_longitudinalis.start up to its level, forward along it, up the tip line."""
+    from artic_cli.config import InferiorLongitudinalis
+    from artic_cli.geometry.mesh import tongue_node_index
+
+    nc = cfg.speaker.tongue.concentric_sections
+    node = lambda k, j, p: int(tongue_node_index(k, j, p, nc))  # noqa: E731
+    old = build_body(cfg).fibres["IL"][0]  # the key's default: along level 2 from radial 10
+    p = int(old[0]) % 3  # the first fibre's plane (node numbers run plane fastest)
+    assert list(old) == [node(k, 2, p) for k in range(10, 0, -1)] + [node(0, j, p) for j in range(3, nc + 1)]
+    low = build_body(cfg, il_route=InferiorLongitudinalis(start=(8, 0), level=1)).fibres["IL"][0]
+    assert list(low) == [node(8, 0, p)] + [node(k, 1, p) for k in range(8, 0, -1)] + [
+        node(0, j, p) for j in range(2, nc + 1)]
+    with pytest.raises(ValueError, match="start level 3 lies above"):
+        InferiorLongitudinalis(start=(8, 3), level=1)
+    with pytest.raises(ArticError, match="muscles.inferior_longitudinalis"):
+        build_body(cfg, il_route=InferiorLongitudinalis(start=(11, 0), level=1))
