@@ -143,7 +143,8 @@ def write(path: Path | str, traj: Trajectory, model: Model, prov: Provenance | N
         f.attrs.update({"dt_s": traj.stats["dt"], "scheme": opt.scheme, "newton_tol_cm": opt.tol,
                         "newton_max_iter": opt.max_iter, "refactor_rate": opt.refactor_rate,
                         "volume_constraint": model.volume_constraint, "wall_time_s": traj.stats["wall_time_s"],
-                        "cpu_time_s": traj.stats["cpu_time_s"], "steps": traj.stats["steps"], "factorisations": traj.stats["refactors"],
+                        "cpu_time_s": traj.stats["cpu_time_s"], "steps": traj.stats["steps"],
+                        "factorisations": traj.stats["refactors"],
                         "newton_iterations": traj.stats["newton_iterations"],
                         "max_abs_volume_change": float(np.nanmax(np.abs(traj.volume_change)))})
         f.create_dataset("time", data=traj.time).attrs["units"] = "s"

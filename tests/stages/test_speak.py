@@ -191,17 +191,17 @@ def test_a_laminal_stop_seals_the_blade_on_the_ridge_silently(tmp_path, mesh_fil
     assert where[0] > 2.0, where  # the lips 1 cm, the incisors' section 0.15 cm: the blade closes on the ridge
     # the closure is the tongue's, not the teeth's: while closed, the lower incisor edge stays >= 0.1 cm from the
     # upper incisor (JC 3 N puts it on the upper one and the tract then closes between them)
+    from artic_cli.control.solver import _polyline_nearest
+
     upper = np.array(yaml.safe_load((ROOT / "configs" / "default.yaml").read_text())["vocal_tract"]["upper_incisor_cm"])
-    a, b = upper[:-1], upper[1:]
-    for p in rec.control_points["jaw"][closed][:, :2]:
-        s = np.clip(np.einsum("ij,ij->i", p - a, b - a) / np.einsum("ij,ij->i", b - a, b - a), 0.0, 1.0)
-        assert np.linalg.norm(p - a - s[:, None] * (b - a), axis=1).min() >= 0.1
+    assert min(_polyline_nearest(upper, p)[0] for p in rec.control_points["jaw"][closed][:, :2]) >= 0.1
     assert m["peak_speed_cm_s"]["tip"] <= 60.0 and m["peak_speed_cm_s"]["jaw"] <= 18.0
     assert rec.attrs["max_beyond_wall_cm"] <= 0.01 and np.nanmax(np.abs(rec.volume_change)) <= 0.003
 
 
 def test_an_alveolar_channel_makes_s_frication_20_db_above_the_vowels(tmp_path, mesh_file):
-    """/asa/ as configs/utterances/asa.yaml speaks it, /s/'s forces as solved (T-SL 3.88 N, i.e. T and SL 1.94 N each, + GGp 4.91 N, JC 1.5 N):
+    """/asa/ as configs/utterances/asa.yaml speaks it, /s/'s forces as solved (T-SL 3.88 N, i.e. T and SL 1.94 N
+    each, + GGp 4.91 N, JC 1.5 N):
     a channel of about 0.1 cm^2 behind the incisors for the whole /s/, no closure, and the sound above 3 kHz
     during it at least 20 dB above the vowels' (the utterances issue's goal)."""
     fric = {"forces_n": {"JC": 1.5, "T-SL": 3.8839, "GGp": 4.9116}, "duration_ms": 150, "label": "s", "lead_ms": 150}
