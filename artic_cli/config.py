@@ -187,6 +187,9 @@ class Jaw(Strict):
     # the tongue floor's links to the hyoid bear compression only, their tension levelling off over this
     # strain (the floor rests on the hyoid); null: full springs (docs/modelling.md)
     floor_slack_strain: Annotated[float, Field(gt=0, le=1)] | None = None
+    # the strap muscles (sternohyoid, thyrohyoid) bear tension only, their push levelling off over this much
+    # shortening (passive muscle pulls, it does not push); null: full springs both ways (docs/modelling.md)
+    strap_slack_strain: Annotated[float, Field(gt=0, le=1)] | None = None
     # the tongue floor also hangs from the mylohyoid lines (the floor of the mouth): each floor node linked to
     # its two nearest mylohyoid points on the mandible, links like the floor's (docs/modelling.md)
     floor_on_mylohyoid: bool = False

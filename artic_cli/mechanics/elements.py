@@ -8,9 +8,11 @@ A = A0 (1 - nu e)^2, and carries the axial tension
 
 where E(e) = E0 below the stiffening strain and E0 exp(rate (e - e_s)) above
 it (Duck 1990, as the paper uses).  A link with a finite ``slack`` strain d
-bears compression only: its tension E0 A (e - e^2 / (2 d)) levels off over
-0 < e < d at E0 A d / 2 and stays there (the tongue floor resting on the
-hyoid: it pushes, it barely pulls; the tangent stays continuous and >= 0).
+has its tension E0 A (e - e^2 / (2 d)) level off over the strains between
+0 and d at E0 A d / 2 and stay there: with d > 0 it bears compression only
+(the tongue floor resting on the hyoid: it pushes, it barely pulls), with
+d < 0 tension only (a strap muscle: it pulls, it barely pushes); the tangent
+stays continuous and >= 0.
 All functions take and return arrays over every cylinder at once, in CGS
 units.
 
@@ -88,6 +90,13 @@ class DampingFrame:
     c: np.ndarray  # (C,) eta A / l0, dyn s/cm
 
 
+def gives_way(slack: np.ndarray, strain: np.ndarray) -> np.ndarray:
+    """(C,) the links strained on the side their finite slack strain lies (where the slack law holds)."""
+    out = np.isfinite(slack)
+    out[out] = strain[out] * slack[out] > 0.0
+    return out
+
+
 def youngs_modulus(cyl: CylinderSet, strain: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """E(e) and dE/de (the secant modulus: tension = E(e) e A)."""
     over = strain - cyl.knee
@@ -96,14 +105,13 @@ def youngs_modulus(cyl: CylinderSet, strain: np.ndarray) -> tuple[np.ndarray, np
         growth = np.exp(np.minimum(cyl.rate * np.maximum(over, 0.0), 50.0))
         e = cyl.youngs * growth
         de = np.where(over > 0, cyl.rate * e, 0.0)
-    d = cyl.slack_strain
-    slack = (strain > 0) & np.isfinite(d)
+    slack = gives_way(cyl.slack_strain, strain)
     if slack.any():
         e, de = np.array(e, dtype=float, copy=True), np.array(de, dtype=float, copy=True)
-        e0, s, dd = np.broadcast_to(cyl.youngs, strain.shape)[slack], strain[slack], d[slack]
-        level = s >= dd  # tension held at E0 d / 2
-        e[slack] = np.where(level, e0 * dd / (2.0 * np.maximum(s, 1e-300)), e0 * (1.0 - s / (2.0 * dd)))
-        de[slack] = np.where(level, -e0 * dd / (2.0 * np.maximum(s, 1e-300) ** 2), -e0 / (2.0 * dd))
+        e0, s, dd = np.broadcast_to(cyl.youngs, strain.shape)[slack], strain[slack], cyl.slack_strain[slack]
+        level = s / dd >= 1.0  # tension held at E0 d / 2
+        e[slack] = np.where(level, e0 * dd / (2.0 * s), e0 * (1.0 - s / (2.0 * dd)))
+        de[slack] = np.where(level, -e0 * dd / (2.0 * s**2), -e0 / (2.0 * dd))
     return e, de
 
 
@@ -172,9 +180,9 @@ def strain_energy(cyl: CylinderSet, strain: np.ndarray, points: int = 8) -> np.n
     stress = cyl.youngs * np.exp(np.minimum(cyl.rate * over, 50.0)) * e * shrink * shrink
     energy = cyl.area0 * cyl.l0 * 0.5 * strain * (w[:, None] * stress).sum(axis=0)
     d = cyl.slack_strain
-    slack = (strain > 0) & np.isfinite(d)
+    slack = gives_way(d, strain)
     if slack.any():  # the slack law in closed form (its links have no radius law: poisson 0)
         st, dd = strain[slack], d[slack]
-        density = np.where(st < dd, st**2 / 2.0 - st**3 / (6.0 * dd), dd**2 / 3.0 + dd * (st - dd) / 2.0)
+        density = np.where(st / dd < 1.0, st**2 / 2.0 - st**3 / (6.0 * dd), dd**2 / 3.0 + dd * (st - dd) / 2.0)
         energy[slack] = (cyl.area0 * cyl.l0 * np.broadcast_to(cyl.youngs, strain.shape))[slack] * density
     return energy

@@ -59,8 +59,8 @@ def cylinder_state(x, ci, cj, l0, area0, youngs, poisson, knee, rate, slack):
             sh = 0.05
         shrink[k] = sh
         over = s - knee[k]
-        if s > 0.0 and slack[k] < np.inf:
-            if s >= slack[k]:
+        if abs(slack[k]) < np.inf and s * slack[k] > 0.0:  # the side the link gives way on
+            if s / slack[k] >= 1.0:
                 e[k] = youngs[k] * slack[k] / (2.0 * s)
                 de[k] = -youngs[k] * slack[k] / (2.0 * s * s)
             else:

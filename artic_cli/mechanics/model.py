@@ -360,6 +360,8 @@ def _links(body: Body, cfg: Config, tissue_scale: float) -> tuple[CylinderSet, n
     slack = np.full(n, np.inf)
     if jaw.floor_slack_strain is not None:  # the floor rests on the hyoid: compression only
         slack[floor] = jaw.floor_slack_strain
+    if jaw.strap_slack_strain is not None:  # the straps pull only: their slack on the shortening side
+        slack[kinds == LINK_KINDS.index("strap")] = -jaw.strap_slack_strain
     cyl = CylinderSet(i=i, j=j, l0=l0, area0=area, youngs=e, viscosity=eta, poisson=np.zeros(n),
                       knee=np.full(n, np.inf), rate=np.zeros(n), n_nodes=len(x), slack=slack)
     return cyl, mass, kinds

@@ -92,16 +92,18 @@ def _slack_links(delta=0.01, n=400):
     return cyl, strain
 
 
-def test_a_slack_link_pushes_fully_and_its_pull_levels_off():
-    delta = 0.01
+@pytest.mark.parametrize("delta", [0.01, -0.01])
+def test_a_slack_link_bears_one_side_fully_and_levels_off_on_the_other(delta):
+    # delta > 0: pushes fully, its pull levels off (the floor); delta < 0: pulls fully, its push levels off (straps)
     cyl, strain = _slack_links(delta)
     e, de = elements.youngs_modulus(cyl, strain)
     tension = e * strain * cyl.area0
     full = cyl.youngs * cyl.area0
-    comp = strain <= 0
-    assert np.allclose(tension[comp], full[comp] * strain[comp])  # compression: the whole spring
+    whole = strain * delta <= 0
+    assert np.allclose(tension[whole], full[whole] * strain[whole])  # the side it bears: the whole spring
     assert np.all(np.diff(tension) >= -1e-9)  # monotone: no negative stiffness for Newton
-    assert np.allclose(tension[strain >= delta], full[0] * delta / 2)  # the pull's ceiling, E0 A d / 2
+    assert np.allclose(tension[strain / delta >= 1], full[0] * delta / 2)  # the ceiling, E0 A d / 2
+    assert np.abs(tension[~whole]).max() <= full[0] * abs(delta) / 2 * (1 + 1e-12)
     # the tangent the integrator uses is the derivative of the tension, across both joints (0 and d)
     cs = elements.CylinderState(n=np.tile([1.0, 0, 0], (len(strain), 1)), length=cyl.l0 * (1 + strain),
                                 strain=strain, elastic=tension, shrink=np.ones_like(strain), e=e, de=de)
@@ -110,10 +112,11 @@ def test_a_slack_link_pushes_fully_and_its_pull_levels_off():
     assert np.allclose(elements.axial_stiffness(cyl, cs)[inner], numeric[inner], rtol=1e-3, atol=1e-6 * full[0])
 
 
-def test_a_slack_link_gives_the_same_numbers_compiled_and_in_numpy_and_its_energy_integrates_its_tension():
-    cyl, strain = _slack_links(0.005)
+@pytest.mark.parametrize("delta", [0.005, -0.005])
+def test_a_slack_link_gives_the_same_numbers_compiled_and_in_numpy_and_its_energy_integrates_its_tension(delta):
+    cyl, strain = _slack_links(delta)
     x = np.zeros((2, 3))  # one link along x
-    for s in (-0.03, 0.002, 0.004, 0.02):
+    for s in (-0.03, -0.004, -0.002, 0.002, 0.004, 0.02):
         x[1] = [1.5 * (1 + s), 0, 0]
         one = elements.CylinderSet(**{f: getattr(cyl, f)[:1] for f in ("i", "j", "l0", "area0", "youngs",
                                                                       "viscosity", "poisson", "knee", "rate")},
@@ -124,7 +127,8 @@ def test_a_slack_link_gives_the_same_numbers_compiled_and_in_numpy_and_its_energ
     w = elements.strain_energy(cyl, strain)
     e, _ = elements.youngs_modulus(cyl, strain)
     tension = e * strain * cyl.area0
-    assert np.allclose(np.gradient(w, strain * cyl.l0[0])[1:-1], tension[1:-1], rtol=2e-3, atol=1e-3 * tension.max())
+    scale = np.abs(tension).max()
+    assert np.allclose(np.gradient(w, strain * cyl.l0[0])[1:-1], tension[1:-1], rtol=2e-3, atol=1e-3 * scale)
 
 
 def test_the_floor_links_go_slack_only_when_the_config_says_so(cfg, mesh, wall):
@@ -138,3 +142,17 @@ def test_the_floor_links_go_slack_only_when_the_config_says_so(cfg, mesh, wall):
     assert np.isinf(full.springs.slack_strain).all() == (cfg.jaw.floor_slack_strain is None)
     assert np.isfinite(slack.springs.slack_strain).sum() == n_floor > 0
     assert np.allclose(slack.springs.slack_strain[np.isfinite(slack.springs.slack_strain)], 0.005)
+
+
+def test_the_straps_pull_only_when_the_config_says_so(cfg, mesh, wall):
+    from artic_cli.geometry.anatomy import LINK_KINDS, build_body
+    from artic_cli.mechanics.model import build_articulator
+
+    body = build_body(cfg, mesh)
+    straps = {tuple(sorted(p)) for p, k in zip(body.links.tolist(), body.link_kind) if k == LINK_KINDS.index("strap")}
+    jaw = cfg.jaw.model_copy(update={"strap_slack_strain": 0.004, "floor_slack_strain": None})
+    model = build_articulator(cfg.model_copy(update={"jaw": jaw}), mesh, wall)
+    d = model.springs.slack_strain
+    pairs = [tuple(sorted(p)) for p in zip(model.springs.i.tolist(), model.springs.j.tolist())]
+    assert len(straps) == 4 and {p for p, v in zip(pairs, d) if np.isfinite(v)} == straps
+    assert np.allclose(d[np.isfinite(d)], -0.004)  # negative: the push side gives way
