@@ -142,8 +142,15 @@ def axial_stiffness(cyl: CylinderSet, cs: CylinderState) -> np.ndarray:
 
 
 def damping_frame(cyl: CylinderSet, x: np.ndarray) -> DampingFrame:
+    """The step's dashpot axes and coefficients.  A link on the side it gives way (its slack law) damps as
+    it stiffens, in proportion to its tangent, 1 - e / d (0 past d): its relaxation time stays the same."""
     cs = evaluate(cyl, x)
-    return DampingFrame(n=cs.n, c=cyl.viscosity * cyl.area0 * cs.shrink * cs.shrink / cyl.l0)
+    c = cyl.viscosity * cyl.area0 * cs.shrink * cs.shrink / cyl.l0
+    slack = gives_way(cyl.slack_strain, cs.strain)
+    if slack.any():
+        c = c.copy()
+        c[slack] *= np.clip(1.0 - cs.strain[slack] / cyl.slack_strain[slack], 0.0, 1.0)
+    return DampingFrame(n=cs.n, c=c)
 
 
 def nodal_forces(cyl: CylinderSet, cs: CylinderState, frame: DampingFrame | None, v: np.ndarray | None,

@@ -136,8 +136,9 @@ def test_the_floor_links_go_slack_only_when_the_config_says_so(cfg, mesh, wall):
     from artic_cli.mechanics.model import build_articulator
 
     n_floor = int((build_body(cfg, mesh).link_kind == LINK_KINDS.index("floor")).sum())
-    full = build_articulator(cfg, mesh, wall)
-    slack = build_articulator(cfg.model_copy(update={"jaw": cfg.jaw.model_copy(update={"floor_slack_strain": 0.005})}),
+    springs = cfg.jaw.model_copy(update={"strap_slack_strain": None})  # the straps' own slack: the next test
+    full = build_articulator(cfg.model_copy(update={"jaw": springs}), mesh, wall)
+    slack = build_articulator(cfg.model_copy(update={"jaw": springs.model_copy(update={"floor_slack_strain": 0.005})}),
                               mesh, wall)
     assert np.isinf(full.springs.slack_strain).all() == (cfg.jaw.floor_slack_strain is None)
     assert np.isfinite(slack.springs.slack_strain).sum() == n_floor > 0
@@ -156,3 +157,18 @@ def test_the_straps_pull_only_when_the_config_says_so(cfg, mesh, wall):
     pairs = [tuple(sorted(p)) for p in zip(model.springs.i.tolist(), model.springs.j.tolist())]
     assert len(straps) == 4 and {p for p, v in zip(pairs, d) if np.isfinite(v)} == straps
     assert np.allclose(d[np.isfinite(d)], -0.004)  # negative: the push side gives way
+
+
+@pytest.mark.parametrize("delta", [0.01, -0.01])
+def test_a_slack_link_damps_in_proportion_to_its_tangent_on_the_side_it_gives_way(delta):
+    cyl, strain = _slack_links(delta, n=5)
+    cyl = elements.CylinderSet(**{f: getattr(cyl, f) for f in ("i", "j", "l0", "area0", "youngs", "poisson", "knee",
+                                                              "rate")}, viscosity=np.full(5, 3.0), n_nodes=2,
+                               slack=cyl.slack)
+    for s, share in ((-0.5 * delta, 1.0), (0.0, 1.0), (0.5 * delta, 0.5), (delta, 0.0), (3 * delta, 0.0)):
+        x = np.array([[0.0, 0, 0], [1.5 * (1 + s), 0, 0]])
+        one = elements.CylinderSet(**{f: getattr(cyl, f)[:1] for f in ("i", "j", "l0", "area0", "youngs", "viscosity",
+                                                                      "poisson", "knee", "rate")},
+                                   n_nodes=2, slack=cyl.slack[:1])
+        full = 3.0 * 0.3 / 1.5
+        assert elements.damping_frame(one, x).c[0] == pytest.approx(share * full, abs=1e-12)
