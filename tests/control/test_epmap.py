@@ -95,6 +95,25 @@ def test_four_starting_shapes_reach_one_equilibrium(art):
         assert r.ours <= 0.05, r
 
 
+def test_the_open_jaw_reaches_one_equilibrium_whether_its_forces_step_or_open_with_a_pulse(art):
+    """/a/'s forces (GGp 1.76 N, JO 6 N) from rest for 1.2 s, switched on as a step (the EP maps' and the vowel
+    solver's hold) or opened with a 40-ms pulse of twice the forces (the utterances' pulse_step): one EP, the
+    dorsum's two ends within 0.05 cm.  With the straps pulling only (jaw.strap_slack_strain 0.006) the step
+    sinks the hyoid 0.8 cm onto the straps' flat push and the pulse does not: the two ends lie 0.31 cm apart."""
+    from artic_cli.control.course import activated, course
+    from artic_cli.mechanics.loads import control_from_newtons
+    from artic_cli.mechanics.simulate import run, settle
+
+    forces = np.array([1.7648, 6.0])
+    rest = settle(art)
+    pulse = activated(course([0.0, 0.04], [2 * forces, forces], 0.03), 1.3, 0.015, 0.05)
+    ends = []
+    for f in (lambda t: forces, pulse):
+        _, end = run(art, rest, lambda t, f=f: control_from_newtons(art, dict(zip(("GGp", "JO"), f(t)))), 1.2)
+        ends.append(end.x[art.control_points()["dorsum"], :2])
+    assert np.linalg.norm(ends[0] - ends[1]) <= 0.05, ends
+
+
 @pytest.fixture(scope="module")
 def small(tmp_path_factory, mesh_file):
     tmp = tmp_path_factory.mktemp("small")
