@@ -9,8 +9,9 @@ vector as the report does (GH included); k, dir and t3 hold the jaw when the con
 eight jaw EPs (cm); fm: F1-F3 (Hz) of the rest tract and of a few held muscle sets; settle: how many floor-muscle
 EPs (HG, GH, MH, GGp at 1-6 N) have not settled after the EP maps' hold, jaw free and held; hold300: the same
 muscles at every map level with the jaw held and the paper's fixed 300-ms hold (what the EP-map tests assert);
-fig7: Fig. 7's worst end-point spread (goal 0.05 cm); stress: the 7-N run's volume change (goal 0.3 %); the last
-four are not in the default parts.  Not part of make bench (it measures behaviour, not speed).
+fig7: Fig. 7's worst end-point spread (goal 0.05 cm); stress: the 7-N run's volume change (goal 0.3 %); t4:
+Table IV's mean distances at JO_4 and JO_6 from single-vector maps (the typical JO_0.5 map carried by the best
+rotation and shift; the worst muscles named; about 90 s); the last five are not in the default parts.  Not part of make bench (it measures behaviour, not speed).
 """
 
 from __future__ import annotations
@@ -150,6 +151,35 @@ def fixed_hold(cfg, model, rest) -> None:
           f"window): {bad}")
 
 
+def table_iv(cfg, model) -> None:
+    """Table IV on single-vector maps: each open jaw position's EPs against the typical map's, carried by the
+    least-squares rotation and shift (``control.dynamic``'s fit), per control point."""
+    from artic_cli.control.dynamic import PAPER_TABLE_IV, procrustes_2d, rotation
+    from artic_cli.control.equilibrium import equilibrium_point, jaw_rest
+
+    spec = cfg.epmap
+    muscles, levels = list(spec.muscles), [f for f in spec.levels_n if f > 0]
+
+    def cloud(jaw_forces):
+        start = jaw_rest(model, jaw_forces)
+        w = list(model.control_points().values())
+        eps = {(m, 0.0): start.x[w] for m in muscles}
+        eps |= {(m, f): equilibrium_point(model, start, {**jaw_forces, m: f}, spec).x for m in muscles for f in levels}
+        return np.array([[eps[(m, f)][c, :2] for m in muscles for f in (0.0, *levels)] for c in (0, 1)])
+
+    typical = cloud(spec.jaw_positions[spec.typical_jaw])
+    for jaw in ("JO_4", "JO_6"):
+        q_all, cells = cloud(spec.jaw_positions[jaw]), []
+        for c, cp in enumerate(CPS):
+            p, q = typical[c], q_all[c]
+            theta, _ = procrustes_2d(p, q)
+            d = np.linalg.norm((p - p.mean(axis=0)) @ rotation(theta).T + q.mean(axis=0) - q, axis=1)
+            per = d.reshape(len(muscles), -1).mean(axis=1)
+            worst = ", ".join(f"{muscles[k]} {per[k]:.2f}" for k in np.argsort(-per)[:3])
+            cells.append(f"{cp} {d.mean():.3f} cm (paper {PAPER_TABLE_IV[jaw][1 + c]:.3f}; worst {worst})")
+        print(f"  {jaw}: " + " | ".join(cells))
+
+
 def fig7_spread(model) -> None:
     rows = [r for r in P.fig7(model) if "spread" in r.name]
     worst = max(rows, key=lambda r: r.ours)
@@ -187,6 +217,7 @@ def main() -> None:
                             lambda: settling(cfg, model, rest)),
                            ("hold300", "map levels, jaw held, fixed hold (cm moved over the last window)",
                             lambda: fixed_hold(cfg, model, rest)),
+                           ("t4", "Table IV (single-vector maps; goal 0.15 cm)", lambda: table_iv(cfg, model)),
                            ("fig7", "Fig. 7 (one EP per force)", lambda: fig7_spread(model)),
                            ("stress", "7 N on GGp, SG, HG, SL, IL", lambda: stress_volume(model))):
         if key in parts:
