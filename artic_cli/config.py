@@ -181,6 +181,9 @@ class Jaw(Strict):
     # the whole digastric; false: it ends at the sling, as the paper's (docs/modelling.md)
     digastric_through_sling: bool = False
     floor_link_area_cm2: Positive = 0.3
+    # the floor's links to the mylohyoid lines (``floor_on_mylohyoid``): the floor of the mouth's stiffness,
+    # which carries the tongue with the mandible as the jaw opens; null: ``floor_link_area_cm2`` (docs/modelling.md)
+    sling_link_area_cm2: Positive | None = None
     # the planes in which the mandible carries the tongue's GG tendon line (innermost concentric line): all
     # three, or the midsagittal one only, where the genial tubercle is (docs/modelling.md)
     gg_tendon: Literal["all", "midsagittal"] = "all"

@@ -343,6 +343,8 @@ def _links(body: Body, cfg: Config, tissue_scale: float) -> tuple[CylinderSet, n
     floor = kinds == LINK_KINDS.index("floor")
     tissue_links = floor | (kinds == LINK_KINDS.index("sling"))  # the floor's links to the hyoid and mandible
     area[tissue_links] = jaw.floor_link_area_cm2
+    if jaw.sling_link_area_cm2 is not None:
+        area[kinds == LINK_KINDS.index("sling")] = jaw.sling_link_area_cm2
     e[tissue_links] = tissue_scale * units.kpa_to_cgs(tissue.youngs_modulus_kpa)
     eta[tissue_links] = tissue_scale * units.kpa_to_cgs(tissue.viscosity_kpa_s)
     relax = units.ms_to_s(jaw.passive_relaxation_ms)  # dashpot = relaxation time x spring

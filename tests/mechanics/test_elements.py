@@ -159,6 +159,26 @@ def test_the_straps_pull_only_when_the_config_says_so(cfg, mesh, wall):
     assert np.allclose(d[np.isfinite(d)], -0.004)  # negative: the push side gives way
 
 
+def test_the_sling_links_take_their_own_area_only_when_the_config_gives_one(cfg, mesh, wall):
+    from artic_cli.geometry.anatomy import LINK_KINDS, build_body
+    from artic_cli.mechanics.model import build_articulator
+
+    body = build_body(cfg, mesh, floor_on_mylohyoid=True)
+    kind = {tuple(sorted(p)): k for p, k in zip(body.links.tolist(), body.link_kind)}
+    floor, sling = LINK_KINDS.index("floor"), LINK_KINDS.index("sling")
+
+    def areas(**jaw):
+        model = build_articulator(cfg.model_copy(update={"jaw": cfg.jaw.model_copy(update={
+            "floor_on_mylohyoid": True, "floor_link_area_cm2": 0.3, **jaw})}), mesh, wall)
+        pairs = [tuple(sorted(p)) for p in zip(model.springs.i.tolist(), model.springs.j.tolist())]
+        a = model.springs.area0
+        return ({round(float(v), 9) for p, v in zip(pairs, a) if kind.get(p) == floor},
+                {round(float(v), 9) for p, v in zip(pairs, a) if kind.get(p) == sling})
+
+    assert areas(sling_link_area_cm2=None) == ({0.3}, {0.3})
+    assert areas(sling_link_area_cm2=1.2) == ({0.3}, {1.2})
+
+
 @pytest.mark.parametrize("delta", [0.01, -0.01])
 def test_a_slack_link_damps_in_proportion_to_its_tangent_on_the_side_it_gives_way(delta):
     cyl, strain = _slack_links(delta, n=5)
