@@ -1,6 +1,9 @@
 """Fidelity scorecard: the muscles' behaviour against Dang & Honda (2004) for any config, in about 15 s.
 
-    python benchmarks/fidelity.py [CONFIG] [--parts k,dir,t3,fig4,jaw,fm,settle]
+    python benchmarks/fidelity.py [CONFIG] [--parts k,dir,t3,fig4,jaw,fm,settle] [--set KEY=VALUE ...]
+
+--set overrides one config key by its dotted path (VALUE read as YAML, the whole config validated again),
+e.g. --set jaw.sling_link_area_cm2=1.2 --set 'muscles.groups.JO={lateral_pterygoid_upper: 0.35, ...}'.
 
 k: SG alone at 0.5-4 N, jaw at rest: first dorsum-region contact and the dorsum's gap to the wall (cm);
 dir: the 16 definite directions of section IV.A.1 at 4 N (deg from the paper's; X: over 45 deg or a move
@@ -18,11 +21,15 @@ of make bench (it measures behaviour, not speed).
 from __future__ import annotations
 
 import argparse
+import sys
 import time
 
 import numpy as np
 
-from artic_cli.config import load_config
+import yaml
+
+from artic_cli.config import load_config, parse_config
+from artic_cli.errors import ArticError
 from artic_cli.experiments import paper as P
 from artic_cli.geometry.mesh import tongue_mesh
 from artic_cli.geometry.wall import wall_surface
@@ -193,14 +200,37 @@ def stress_volume(model) -> None:
     print(f"  7 N run: volume change {vol:.3f} % (goal 0.3 %), finite {bool(rows.get('finite positions', 0))}")
 
 
+def with_overrides(cfg, sets: list[str]):
+    """``cfg`` with each ``KEY=VALUE`` applied at its dotted path (VALUE parsed as YAML), validated again."""
+    data = cfg.model_dump(mode="json")
+    for item in sets:
+        key, sep, value = item.partition("=")
+        if not sep:
+            raise ArticError(f"--set {item!r}: give KEY=VALUE, e.g. jaw.sling_link_area_cm2=1.2")
+        *path, last = key.split(".")
+        node = data
+        for part in path:
+            if not isinstance(node.get(part), dict):
+                raise ArticError(f"--set {key}: the config has no section {part!r} there; see configs/default.yaml")
+            node = node[part]
+        node[last] = yaml.safe_load(value)
+    return parse_config(data, "--set")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("config", nargs="?", default=None)
     ap.add_argument("--parts", default="k,dir,t3,fig4,jaw,fm")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="override a config key by its dotted path (VALUE as YAML)")
     args = ap.parse_args()
     parts = args.parts.split(",")
     t0 = time.perf_counter()
-    cfg = load_config(args.config)
+    try:
+        cfg = with_overrides(load_config(args.config), args.set)
+    except ArticError as err:
+        print(f"error: {err}", file=sys.stderr)
+        raise SystemExit(2) from None
     model = build_articulator(cfg, tongue_mesh(cfg.speaker.tongue), wall_surface(cfg.speaker.wall))
     rest = settle(model)
     pts = model.control_points()
