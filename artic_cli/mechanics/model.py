@@ -340,11 +340,10 @@ def _links(body: Body, cfg: Config, tissue_scale: float) -> tuple[CylinderSet, n
     stiff = np.isin(kinds, [LINK_KINDS.index(k) for k in ("mandible", "hyoid")])
     e[stiff] = units.kpa_to_cgs(bone.youngs_modulus_kpa)
     eta[stiff] = units.kpa_to_cgs(bone.viscosity_kpa_s)
-    floor = kinds == LINK_KINDS.index("floor")
-    tissue_links = floor | (kinds == LINK_KINDS.index("sling"))  # the floor's links to the hyoid and mandible
-    area[tissue_links] = jaw.floor_link_area_cm2
-    if jaw.sling_link_area_cm2 is not None:
-        area[kinds == LINK_KINDS.index("sling")] = jaw.sling_link_area_cm2
+    floor, sling = kinds == LINK_KINDS.index("floor"), kinds == LINK_KINDS.index("sling")
+    tissue_links = floor | sling  # the floor's links to the hyoid and mandible
+    area[floor] = jaw.floor_link_area_cm2
+    area[sling] = jaw.floor_link_area_cm2 if jaw.sling_link_area_cm2 is None else jaw.sling_link_area_cm2
     e[tissue_links] = tissue_scale * units.kpa_to_cgs(tissue.youngs_modulus_kpa)
     eta[tissue_links] = tissue_scale * units.kpa_to_cgs(tissue.viscosity_kpa_s)
     relax = units.ms_to_s(jaw.passive_relaxation_ms)  # dashpot = relaxation time x spring
