@@ -110,15 +110,19 @@ class Simulation(Strict):
 
 
 class InferiorLongitudinalis(Strict):
-    """IL's fibre in each plane: from node (radial, level) ``start`` up its radial line to ``level``, forward
-    along that concentric level to radial 1, then up the tip's radial line to the tip."""
+    """IL's fibre in each plane from node (radial, level) ``start`` to the tip.  ``path: level``: up its
+    radial line to ``level``, forward along that concentric level to radial 1, then up the tip's radial line
+    to the tip; ``path: straight``: on each radial line the node nearest the straight line from ``start`` to
+    the tip (``level`` unused), a band that pulls the tip toward the start without hooping round the GG
+    tendon (docs/modelling.md)."""
 
     start: tuple[Annotated[int, Field(ge=1)], Annotated[int, Field(ge=0)]] = (10, 2)
     level: Annotated[int, Field(ge=0)] = 2
+    path: Literal["level", "straight"] = "level"
 
     @model_validator(mode="after")
     def _start_below_level(self):
-        if self.start[1] > self.level:
+        if self.path == "level" and self.start[1] > self.level:
             raise ValueError(f"start level {self.start[1]} lies above the level {self.level} IL runs along; "
                              "give a start level at or below it")
         return self

@@ -84,6 +84,15 @@ def _landmark(cfg: Config, key: str):
         raise ArticError(f"config: speaker.landmarks_cm lacks '{key}'; add it (x, y, z in cm)") from None
 
 
+def _straight_route(nodes: np.ndarray, lines: list[list[int]], start_level: int) -> list[int]:
+    """A fibre from ``lines[-1][start_level]`` to the tip (``lines[0][-1]``, the first radial line's surface
+    node) through, on each radial line in between, the node nearest the straight segment joining them."""
+    a, b = nodes[lines[-1][start_level]], nodes[lines[0][-1]]
+    d = (b - a) / np.linalg.norm(b - a)
+    off = lambda i: float(np.linalg.norm(np.cross(nodes[i] - a, d)))  # noqa: E731
+    return [lines[-1][start_level], *(min(line, key=off) for line in lines[-2:0:-1]), lines[0][-1]]
+
+
 def build_body(cfg: Config, mesh: Mesh | None = None, *, digastric_through_sling: bool = False,
                verticalis_sections: int = 4, verticalis_to_level: int = 3, il_midsagittal: bool = False,
                il_route=None, gg_tendon: str = "all",
@@ -226,8 +235,12 @@ def build_body(cfg: Config, mesh: Mesh | None = None, *, digastric_through_sling
             fib["SG"].append(chain([styloid[s], t(ke, je, p)] + [t(k, route.level, p) for k in range(k0, k1 - 1, -1)]))
     # lower side, root to tip, in the parasagittal planes (between GG and HG) and optionally the midsagittal one
     for p in (*sides, mid) if il_midsagittal else sides:
-        fib["IL"].append(chain([t(il_k, j, p) for j in range(il_j, il_level)] + [t(k, il_level, p) for k in range(
-            il_k, 0, -1)] + [t(0, j, p) for j in range(il_level + 1, nc)]))
+        if il_route.path == "straight":
+            fib["IL"].append(chain(_straight_route(mesh.nodes, [[t(k, j, p) for j in range(nc)] for k in range(
+                il_k + 1)], il_j)))
+        else:
+            fib["IL"].append(chain([t(il_k, j, p) for j in range(il_j, il_level)] + [t(k, il_level, p) for k in range(
+                il_k, 0, -1)] + [t(0, j, p) for j in range(il_level + 1, nc)]))
     for s, p in enumerate(sides):
         fib["MH"].append(chain([myl_front[s], t(last, 1, mid)]))
         fib["MH"].append(chain([myl_mid[s], t(last, 3, mid)]))

@@ -126,3 +126,29 @@ def test_il_route_follows_the_config(cfg):
         InferiorLongitudinalis(start=(8, 3), level=1)
     with pytest.raises(ArticError, match="muscles.inferior_longitudinalis"):
         build_body(cfg, il_route=InferiorLongitudinalis(start=(11, 0), level=1))
+
+
+def test_a_straight_il_runs_from_its_start_to_the_tip_near_the_chord(cfg):
+    """path: straight: one node per radial line from the start to the tip, each the line's node nearest the
+    chord, so the fibre bends less than the level route does."""
+    from artic_cli.config import InferiorLongitudinalis
+    from artic_cli.geometry.mesh import tongue_node_index
+
+    nc = cfg.speaker.tongue.concentric_sections
+    body = build_body(cfg, il_route=InferiorLongitudinalis(start=(8, 3), path="straight"))
+    for fibre in body.fibres["IL"]:
+        k, j, p = (np.asarray(a) for a in np.unravel_index(fibre, (cfg.speaker.tongue.radial_sections + 1, nc + 1, 3)))
+        assert list(k) == list(range(8, -1, -1)) and len(set(p)) == 1
+        assert (k[0], j[0]) == (8, 3) and (k[-1], j[-1]) == (0, nc)  # the start, then the tip (surface node)
+        x = body.nodes[fibre]
+        d = (x[-1] - x[0]) / np.linalg.norm(x[-1] - x[0])
+        off = np.linalg.norm(np.cross(x - x[0], d), axis=1)
+        for kk, jj, o in zip(k[1:-1], j[1:-1], off[1:-1]):  # no other node of its radial line lies nearer
+            others = body.nodes[tongue_node_index(kk, np.arange(nc + 1), p[0], nc)]
+            assert o <= np.linalg.norm(np.cross(others - x[0], d), axis=1).min() + 1e-12
+        assert off.max() < 0.3  # cm: within about half a brick of the chord
+    level = build_body(cfg, il_route=InferiorLongitudinalis(start=(8, 3), level=3)).fibres["IL"][0]
+    x = body.nodes[level]
+    d = (x[-1] - x[0]) / np.linalg.norm(x[-1] - x[0])
+    assert np.linalg.norm(np.cross(x - x[0], d), axis=1).max() > 0.5  # the level route arcs round the tendon
+    InferiorLongitudinalis(start=(8, 3), level=1, path="straight")  # the level is unused: no complaint

@@ -174,10 +174,8 @@ def directions(art, cfg):
 
 AGREE = [("GGa", "tip"), ("GGm", "tip"), ("GGm", "dorsum"), ("GGp", "tip"), ("GGp", "dorsum"), ("HG", "tip"),
          ("HG", "dorsum"),
-         ("SG", "tip"), ("SG", "dorsum"), ("SL", "tip"), ("SL", "dorsum"), ("IL", "tip"), ("V", "tip"),
-         ("V", "dorsum"), ("MH", "dorsum")]
-KNOWN = {("IL", "dorsum"): "in a radial fan centred on the GG origin the tongue's lower side is a short arc around "
-                           "the origin; IL pulls the dorsum back-down toward it (76 deg from back-up)"}
+         ("SG", "tip"), ("SG", "dorsum"), ("SL", "tip"), ("SL", "dorsum"), ("IL", "tip"), ("IL", "dorsum"),
+         ("V", "tip"), ("V", "dorsum"), ("MH", "dorsum")]
 
 
 def _angle(row) -> float:
@@ -190,15 +188,9 @@ def test_muscle_moves_its_control_point_the_paper_s_way(directions, muscle, cp):
     assert _angle(row) <= 45.0 and row.ours >= 0.05  # the issue's goal: within 45 deg, a move of 0.05 cm or more
 
 
-@pytest.mark.parametrize("muscle,cp", sorted(KNOWN))
-def test_known_direction_differences(directions, muscle, cp, request):
-    request.node.add_marker(pytest.mark.xfail(strict=True, reason=f"known difference (issue 15 open): {KNOWN[(muscle, cp)]}"))
-    assert _angle(directions[f"{muscle} {cp}"]) <= 45.0
-
-
 def test_every_definite_direction_is_tested():
     listed = {(m, c) for m, d in PAPER_DIRECTIONS.items() for c in d}
-    assert listed == set(AGREE) | set(KNOWN)
+    assert listed == set(AGREE)
 
 
 def test_sg_first_brings_the_dorsum_onto_the_palate_between_0_5_and_2_n(art, cfg):
