@@ -184,6 +184,10 @@ class Jaw(Strict):
     # the anterior digastric's fibre runs on through the hyoid sling to the mastoid, so its strain is taken over
     # the whole digastric; false: it ends at the sling, as the paper's (docs/modelling.md)
     digastric_through_sling: bool = False
+    # where the digastric's sling is: ``fixed``, a point fixed at the hyoid body's rest end (the paper's "fixed
+    # point"); ``hyoid``, the fibrous loop on the hyoid body itself, so the digastric's tension also lifts the
+    # hyoid (docs/modelling.md)
+    digastric_sling: Literal["fixed", "hyoid"] = "fixed"
     floor_link_area_cm2: Positive = 0.3
     # the floor's links to the mylohyoid lines (``floor_on_mylohyoid``): the floor of the mouth's stiffness,
     # which carries the tongue with the mandible as the jaw opens; null: ``floor_link_area_cm2`` (docs/modelling.md)

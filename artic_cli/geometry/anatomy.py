@@ -94,14 +94,16 @@ def _straight_route(nodes: np.ndarray, lines: list[list[int]], start_level: int)
 
 
 def build_body(cfg: Config, mesh: Mesh | None = None, *, digastric_through_sling: bool = False,
+               digastric_sling: str = "fixed",
                verticalis_sections: int = 4, verticalis_to_level: int = 3, il_midsagittal: bool = False,
                il_route=None, gg_tendon: str = "all",
                floor_on_mylohyoid: bool = False, sg_routes=None) -> Body:
     """The articulator's nodes, links and muscle routes.
 
-    ``digastric_through_sling``: the anterior digastric's fibre goes on from the sling to the mastoid (a fixed
-    segment that adds its length to the fibre's); ``verticalis_sections``: the verticalis spans this many radial
-    sections from the tip, from the surface down to concentric level ``verticalis_to_level``; ``il_midsagittal``:
+    ``digastric_through_sling``: the anterior digastric's fibre goes on from the sling to the mastoid (a segment
+    that adds its length to the fibre's); ``digastric_sling``: ``"fixed"``, the sling a skull point at the hyoid
+    body's rest end, or ``"hyoid"``, the hyoid body's own end node; ``verticalis_sections``: the verticalis spans
+    this many radial sections from the tip, from the surface down to concentric level ``verticalis_to_level``; ``il_midsagittal``:
     IL has a fibre in the midsagittal plane as well; ``il_route``: IL's path (``muscles.inferior_longitudinalis``;
     None: that key's default); ``gg_tendon``: the mandible carries the tongue's GG tendon
     line in ``"all"`` three planes or the ``"midsagittal"`` one;
@@ -207,7 +209,10 @@ def build_body(cfg: Config, mesh: Mesh | None = None, *, digastric_through_sling
     med_pt = skull("medial_pterygoid_origin", "medial_pterygoid_origin")
     lat_u = skull("lateral_pterygoid_upper_origin", "lateral_pterygoid_upper_origin")
     lat_l = skull("lateral_pterygoid_lower_origin", "lateral_pterygoid_lower_origin")
-    sling = skull("digastric_sling", "hyoid_body_end")  # the digastric tendon's fixed pulley (paper III.A)
+    if digastric_sling == "hyoid":  # the fibrous loop on the hyoid body: the digastric's tension lifts the hyoid
+        sling = (body_l, body_r)
+    else:
+        sling = skull("digastric_sling", "hyoid_body_end")  # the digastric tendon's fixed pulley (paper III.A)
     sternum = skull("sternum", "sternum")
     thyroid = skull("thyroid", "thyroid")
     for s in (0, 1):
@@ -253,7 +258,7 @@ def build_body(cfg: Config, mesh: Mesh | None = None, *, digastric_through_sling
         fib["medial_pterygoid"].append(chain([med_pt[s], jaw["gonion"][s]]))
         fib["lateral_pterygoid_upper"].append(chain([lat_u[s], jaw["condyle"][s]]))
         fib["lateral_pterygoid_lower"].append(chain([lat_l[s], jaw["condyle"][s]]))
-        beyond = [mastoid[s]] if digastric_through_sling else []  # the fixed segment on to the mastoid
+        beyond = [mastoid[s]] if digastric_through_sling else []  # the segment on to the mastoid
         fib["anterior_digastric"].append(chain([dig_fossa[s], sling[s], *beyond]))
         fib["posterior_digastric"].append(chain([mastoid[s], (body_l, body_r)[s]]))
     for p in range(planes):

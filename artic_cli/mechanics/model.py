@@ -383,6 +383,7 @@ def build_articulator(cfg: Config, mesh: Mesh, wall: WallSurface | None = None, 
                       gravity: float | None = None) -> Model:
     """Tongue, jaw and hyoid with all muscles, the condyle guide and (optionally) wall contact."""
     body = build_body(cfg, mesh, digastric_through_sling=cfg.jaw.digastric_through_sling,
+                      digastric_sling=cfg.jaw.digastric_sling,
                       verticalis_sections=cfg.muscles.verticalis_sections,
                       verticalis_to_level=cfg.muscles.verticalis_to_level, il_midsagittal=cfg.muscles.il_midsagittal,
                       il_route=cfg.muscles.inferior_longitudinalis,

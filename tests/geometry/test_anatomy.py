@@ -34,6 +34,17 @@ def test_the_anterior_digastric_ends_at_the_sling_or_runs_on_to_the_mastoid(cfg)
         assert int(b[2]) == int(post[0][0])  # the mastoid end of the same side's posterior belly
 
 
+def test_a_sling_on_the_hyoid_passes_the_digastric_through_the_hyoid_body(cfg):
+    fixed, loop = (build_body(cfg, digastric_through_sling=True, digastric_sling=k) for k in ("fixed", "hyoid"))
+    body_ends = set(loop.hyoid[:2].tolist())
+    for a, b in zip(fixed.fibres["anterior_digastric"], loop.fibres["anterior_digastric"]):
+        assert int(a[1]) in set(fixed.fixed.tolist()) and int(b[1]) in body_ends  # a skull point, then the hyoid's
+        assert int(b[1]) not in set(loop.fixed.tolist())  # ... which moves
+        np.testing.assert_allclose(fixed.nodes[a[1]], loop.nodes[b[1]])  # at the same rest place
+        assert np.sign(loop.nodes[b[1], 2]) == np.sign(loop.nodes[b[0], 2])  # on the fibre's own side
+    assert len(loop.nodes) == len(fixed.nodes) - 2  # no skull points for the sling
+
+
 def test_verticalis_extent_and_a_midsagittal_il_follow_the_config(cfg):
     body = build_body(cfg, verticalis_sections=6, il_midsagittal=True)
     paper = build_body(cfg)
