@@ -104,9 +104,9 @@ def build_body(cfg: Config, mesh: Mesh | None = None, *, digastric_through_sling
     that adds its length to the fibre's); ``digastric_sling``: ``"fixed"``, the sling a skull point at the hyoid
     body's rest end, or ``"hyoid"``, the hyoid body's own end node; ``verticalis_sections``: the verticalis spans
     this many radial sections from the tip, from the surface down to concentric level ``verticalis_to_level``;
-    ``il_midsagittal``: IL has a fibre in the midsagittal plane as well; ``il_route``: IL's path (``muscles.inferior_longitudinalis``;
-    None: that key's default); ``gg_tendon``: the mandible carries the tongue's GG tendon
-    line in ``"all"`` three planes or the ``"midsagittal"`` one;
+    ``il_midsagittal``: IL has a fibre in the midsagittal plane as well; ``il_route``: IL's path
+    (``muscles.inferior_longitudinalis``; None: that key's default); ``gg_tendon``: the mandible carries the
+    tongue's GG tendon line in ``"all"`` three planes or the ``"midsagittal"`` one;
     ``floor_on_mylohyoid``: the floor nodes are also linked to their two nearest mylohyoid points;
     ``sg_routes``: SG's fibres per side (``muscles.styloglossus`` items; None: that key's default)."""
     mesh = mesh if mesh is not None else tongue_mesh(cfg.speaker.tongue)
