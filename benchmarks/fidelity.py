@@ -41,6 +41,9 @@ CPS = ("tip", "dorsum")
 
 
 def _gap(model, x, node) -> float:
+    """The node's distance to the wall (cm); nan when the config has no contact."""
+    if model.contact is None:
+        return float("nan")
     return float(-wall_query(model.contact, x, np.array([node]))[2][0])
 
 
