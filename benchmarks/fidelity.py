@@ -14,8 +14,8 @@ EPs (HG, GH, MH, GGp at 1-6 N) have not settled after the EP maps' hold, jaw fre
 muscles at every map level with the jaw held and the paper's fixed 300-ms hold (what the EP-map tests assert);
 fig7: Fig. 7's worst end-point spread (goal 0.05 cm); stress: the 7-N run's volume change (goal 0.3 %); t4:
 Table IV's mean distances at JO_4 and JO_6 from single-vector maps (the typical JO_0.5 map carried by the best
-rotation and shift; the worst muscles named; each position's incisor height from the rest jaw's; about 30 s); the last five are not in the default parts.  Not part
-of make bench (it measures behaviour, not speed).
+rotation and shift; the worst muscles named; each position's incisor height from the rest jaw's; about 30 s);
+the last five are not in the default parts.  Not part of make bench (it measures behaviour, not speed).
 """
 
 from __future__ import annotations
