@@ -318,6 +318,14 @@ def build_model(mesh: Mesh, tissue: TissueMaterial, sim: Simulation, *,
                    bulk_ratio * scale * e0, node_sets=dict(mesh.node_sets))
 
 
+TISSUE_LINKS = ("floor", "sling")  # the tongue floor's links to the hyoid and to the mandible's mylohyoid lines
+
+
+def _of_kind(kinds: np.ndarray, *names: str) -> np.ndarray:
+    """(L,) bool: the links whose kind is one of ``names`` (LINK_KINDS)."""
+    return np.isin(kinds, [LINK_KINDS.index(k) for k in names])
+
+
 def _links(body: Body, cfg: Config, tissue_scale: float) -> tuple[CylinderSet, np.ndarray, np.ndarray]:
     """Passive links of the articulator: bones, floor, straps, jaw muscles' passive springs; their masses
     and kinds (an index of LINK_KINDS, -1 for the jaw muscles' springs)."""
@@ -337,17 +345,17 @@ def _links(body: Body, cfg: Config, tissue_scale: float) -> tuple[CylinderSet, n
     area = np.full(len(i), jaw.link_area_cm2)
     e = np.zeros(len(i))
     eta = np.zeros(len(i))
-    stiff = np.isin(kinds, [LINK_KINDS.index(k) for k in ("mandible", "hyoid")])
+    stiff = _of_kind(kinds, "mandible", "hyoid")
     e[stiff] = units.kpa_to_cgs(bone.youngs_modulus_kpa)
     eta[stiff] = units.kpa_to_cgs(bone.viscosity_kpa_s)
-    floor, sling = kinds == LINK_KINDS.index("floor"), kinds == LINK_KINDS.index("sling")
-    tissue_links = floor | sling  # the floor's links to the hyoid and mandible
+    floor, sling, tissue_links = _of_kind(kinds, "floor"), _of_kind(kinds, "sling"), _of_kind(kinds, *TISSUE_LINKS)
     area[floor] = jaw.floor_link_area_cm2
     area[sling] = jaw.floor_link_area_cm2 if jaw.sling_link_area_cm2 is None else jaw.sling_link_area_cm2
     e[tissue_links] = tissue_scale * units.kpa_to_cgs(tissue.youngs_modulus_kpa)
     eta[tissue_links] = tissue_scale * units.kpa_to_cgs(tissue.viscosity_kpa_s)
     relax = units.ms_to_s(jaw.passive_relaxation_ms)  # dashpot = relaxation time x spring
-    for mask, k_n_cm in ((kinds == LINK_KINDS.index("strap"), jaw.strap_stiffness_n_per_cm),
+    strap = _of_kind(kinds, "strap")
+    for mask, k_n_cm in ((strap, jaw.strap_stiffness_n_per_cm),
                          (kinds == -1, jaw.passive_stiffness_n_per_cm)):
         k = units.newton_to_dyn(k_n_cm)  # dyn/cm
         area[mask] = 1.0
@@ -355,14 +363,14 @@ def _links(body: Body, cfg: Config, tissue_scale: float) -> tuple[CylinderSet, n
         eta[mask] = relax * e[mask]
     mass = np.zeros(len(i))
     for kind, total in (("mandible", bone.mandible_mass_g), ("hyoid", bone.hyoid_mass_g)):
-        m = kinds == LINK_KINDS.index(kind)
+        m = _of_kind(kinds, kind)
         mass[m] = total * l0[m] / l0[m].sum()  # spread uniformly over the bone's links
     n = len(i)
     slack = np.full(n, np.inf)
     if jaw.floor_slack_strain is not None:  # the floor rests on the hyoid: compression only
         slack[floor] = jaw.floor_slack_strain
     if jaw.strap_slack_strain is not None:  # the straps pull only: their slack on the shortening side
-        slack[kinds == LINK_KINDS.index("strap")] = -jaw.strap_slack_strain
+        slack[strap] = -jaw.strap_slack_strain
     cyl = CylinderSet(i=i, j=j, l0=l0, area0=area, youngs=e, viscosity=eta, poisson=np.zeros(n),
                       knee=np.full(n, np.inf), rate=np.zeros(n), n_nodes=len(x), slack=slack)
     return cyl, mass, kinds
@@ -396,7 +404,7 @@ def build_articulator(cfg: Config, mesh: Mesh, wall: WallSurface | None = None, 
     link_mass = np.concatenate([tissue.density_g_cm3 * mesh.areas * tcyl.l0, lmass])
     grav = cfg.simulation.gravity_cm_s2 if gravity is None else gravity
     free = np.setdiff1d(np.arange(len(mesh.nodes)), body.carried)  # the tongue but its GG tendon on the mandible
-    carriers = np.r_[np.ones(len(tcyl), dtype=bool), np.isin(lkind, [LINK_KINDS.index(k) for k in ("floor", "sling")])]
+    carriers = np.r_[np.ones(len(tcyl), dtype=bool), _of_kind(lkind, *TISSUE_LINKS)]
     cyl = _carrying_weight(_concat(tcyl, lcyl), body.nodes, tissue, link_mass, grav, free, carriers)
     on = cfg.simulation.volume_constraint if volume_constraint is None else volume_constraint
     e0 = units.kpa_to_cgs(tissue.youngs_modulus_kpa)
