@@ -16,8 +16,10 @@ os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 from artic_cli.config import load_config  # noqa: E402
 from artic_cli.geometry.mesh import tongue_mesh  # noqa: E402
 from artic_cli.geometry.wall import wall_surface  # noqa: E402
+from artic_cli.speech.plan import plan  # noqa: E402
+from artic_cli.speech.utterance import parse_utterance  # noqa: E402
 from artic_cli.stages import speak  # noqa: E402
-from artic_cli.utterance import parse_utterance  # noqa: E402
+from artic_cli.stages.simulate import build  # noqa: E402
 
 UTTERANCE = {"name": "bench", "f0_hz": [[0.0, 125], [1.0, 100]],
              "segments": [{"forces_n": {"JO": 2.5, "HG": 1.0}, "duration_ms": 300, "label": "a"},
@@ -32,8 +34,8 @@ def main() -> None:
     cfg = load_config()
     mesh, wall = tongue_mesh(cfg.speaker.tongue), wall_surface(cfg.speaker.wall)
     u = parse_utterance(UTTERANCE, "bench")
-    p = speak.plan(u, cfg)
-    model = speak.sim_stage.build(cfg, mesh, wall)
+    p = plan(u, cfg, [None] * len(u.segments), lambda targets: [])  # every segment's forces given
+    model = build(cfg, mesh, wall)
     t0 = time.perf_counter()
     s = speak.compute(u, p, cfg, mesh, wall, model=model)
     total = time.perf_counter() - t0

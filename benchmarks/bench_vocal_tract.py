@@ -10,14 +10,16 @@ import numpy as np
 
 from artic_cli.config import load_config
 from artic_cli.geometry.mesh import tongue_mesh
-from artic_cli.stages.vocal_tract import Shapes, compute, controls_for
+from artic_cli.tract.areas import tracts_of as compute
+from artic_cli.tract.controls import controls_for
+from artic_cli.tract.shapes import Shapes
 from timing import median_time  # benchmarks/timing.py
 
 
 
 def _shapes(mesh, frames: int) -> Shapes:
     """The rest surface moved by a smooth dorsum rise and jaw rotation over ``frames`` frames."""
-    from artic_cli.stages.vocal_tract import surface_nodes
+    from artic_cli.tract.shapes import surface_nodes
 
     mid, lateral = surface_nodes(mesh)
     surf = mesh.nodes[mid, :2]

@@ -33,7 +33,7 @@ from artic_cli.errors import ArticError
 from artic_cli.experiments import paper as P
 from artic_cli.geometry.mesh import tongue_mesh
 from artic_cli.geometry.wall import wall_surface
-from artic_cli.mechanics.contact import wall_query
+from artic_cli.mechanics.wall_query import wall_query
 from artic_cli.mechanics.model import build_articulator
 from artic_cli.mechanics.simulate import settle
 
@@ -109,17 +109,20 @@ def jaw_eps(rest, audit, pts) -> None:
 def formants(cfg, model, rest, audit) -> None:
     from artic_cli.acoustics.tube import Tube
     from artic_cli.stages import acoustics as ac_stage
-    from artic_cli.stages import vocal_tract as vt_stage
+    from artic_cli.tract.areas import port_positions, tracts_of
+    from artic_cli.tract.controls import controls_for
+    from artic_cli.tract.shapes import shapes_of
+    from artic_cli.tract.speaker import speaker_tract
 
     mesh = tongue_mesh(cfg.speaker.tongue)
-    vt = vt_stage.speaker_tract(cfg)
+    vt = speaker_tract(cfg)
     mandible = np.asarray(model.node_sets["mandible"])
 
     def of(x):
-        shapes = vt_stage.shapes_of(x[None], np.zeros(1), mesh, model.rest, mandible)
-        tr = vt_stage.compute(vt, cfg.speaker.wall, shapes, vt_stage.controls_for(vt, np.zeros(1)))
+        shapes = shapes_of(x[None], np.zeros(1), mesh, model.rest, mandible)
+        tr = tracts_of(vt, cfg.speaker.wall, shapes, controls_for(vt, np.zeros(1)))
         res = ac_stage.compute([Tube(tr.af.length_cm[0], tr.af.area_cm2[0])], cfg,
-                               port_from_glottis_cm=ac_stage.port_positions(tr))
+                               port_from_glottis_cm=port_positions(tr))
         return res.formants_hz[0][:3], float(tr.af.area_cm2[0].min())
 
     f, amin = of(rest.x)

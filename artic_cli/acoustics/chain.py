@@ -25,7 +25,7 @@ import numpy as np
 # loads, at the first parallel loop.
 os.environ.setdefault("OMP_WAIT_POLICY", "passive")
 
-from ..mechanics.kernels import AVAILABLE, njit
+from ..jit import AVAILABLE, njit
 
 if AVAILABLE:  # pragma: no cover - numba is a dependency
     from numba import prange

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..mechanics.kernels import njit
+from ..jit import njit
 
 MIN_AREA_CM2 = 1e-4
 

@@ -17,7 +17,7 @@ import numpy as np
 from ..errors import UnreachableTarget
 from ..units import hz_to_bark
 from .epmap import JawMaps
-from .solver import (Candidate, TargetSpec, _bilinear, _polyline_nearest, _settled_run, cell_corners, good_cells,
+from .solver import (Candidate, TargetSpec, bilinear, polyline_nearest, settled_run, cell_corners, good_cells,
                      indecisive_cost, invert_cells)
 
 FormantNets = dict  # "single/SG" | "pair/A+B" | "group/I+A+B" -> (*grid, K) formants of the net's EPs, Hz
@@ -66,7 +66,7 @@ class AcousticProblem:
         out = []
         for m, net in self.jm.single.items():
             f = self.formants.get(f"single/{m}")
-            stop = _settled_run(net)
+            stop = settled_run(net)
             if f is None or stop < 2:
                 continue
             f = f[:stop]
@@ -76,7 +76,7 @@ class AcousticProblem:
                 if stop < 2:
                     continue
                 f = f[:stop]
-            d, k, frac = _polyline_nearest(hz_to_bark(f[:, :2]), self.goal)
+            d, k, frac = polyline_nearest(hz_to_bark(f[:, :2]), self.goal)
             if d > self.reach:
                 continue
             lv = net.levels[0]
@@ -116,7 +116,7 @@ class AcousticProblem:
             bark = hz_to_bark(fc[..., :2])
             u, v, _ = invert_cells(bark, self.goal)
             u, v = np.clip(u, 0.0, 1.0), np.clip(v, 0.0, 1.0)
-            res = np.linalg.norm(_bilinear(bark, u, v) - self.goal, axis=1)
+            res = np.linalg.norm(bilinear(bark, u, v) - self.goal, axis=1)
             for k in np.flatnonzero(res <= self.reach):
                 a, b = muscles[-2], muscles[-1]
                 la, lb = levels
@@ -125,8 +125,8 @@ class AcousticProblem:
                 if fixed is not None:
                     forces[fixed[0]] = forces.get(fixed[0], 0.0) + fixed[1]
                 uu, vv = np.array([u[k]]), np.array([v[k]])
-                pred = _bilinear(cp[k][None], uu, vv)[0].reshape(2, 2)
-                f_hz = _bilinear(fc[k][None], uu, vv)[0]
+                pred = bilinear(cp[k][None], uu, vv)[0].reshape(2, 2)
+                f_hz = bilinear(fc[k][None], uu, vv)[0]
                 label = name if fixed is None else f"{name} ({fixed[0]} {fixed[1]:g} N)"
                 out.append(self._candidate(family, label, forces, pred, f_hz,
                                            {"cell": [int(ii[k]), int(jj[k])], "uv": [float(u[k]), float(v[k])],
@@ -140,11 +140,11 @@ class AcousticProblem:
             f = self.formants.get(f"single/{m}")
             if f is None:
                 continue
-            f = f[: _settled_run(net)]
+            f = f[: settled_run(net)]
             f = f[np.isfinite(f[:, :2]).all(axis=1)]
             if len(f) < 2:
                 continue
-            d, k, frac = _polyline_nearest(hz_to_bark(f[:, :2]), self.goal)
+            d, k, frac = polyline_nearest(hz_to_bark(f[:, :2]), self.goal)
             if d < best[1]:
                 best = (f[k] + frac * (f[k + 1] - f[k]), d, f"vector {m}")
         s = np.linspace(0, 1, 9)
@@ -154,7 +154,7 @@ class AcousticProblem:
             if not len(fc):
                 continue
             c = np.repeat(fc[:, None], len(uu), axis=1)  # (C, S, 4, K)
-            p = _bilinear(c, np.broadcast_to(uu, c.shape[:2]), np.broadcast_to(vv, c.shape[:2]))
+            p = bilinear(c, np.broadcast_to(uu, c.shape[:2]), np.broadcast_to(vv, c.shape[:2]))
             d = np.linalg.norm(hz_to_bark(p[..., :2]) - self.goal, axis=-1)
             k = np.unravel_index(np.argmin(d), d.shape)
             if d[k] < best[1]:

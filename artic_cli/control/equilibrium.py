@@ -14,6 +14,7 @@ import numpy as np
 
 from .. import units
 from ..config import ConfigView, EPMapSpec, parse_config
+from ..errors import ArticError
 from ..geometry.mesh import Mesh
 from ..geometry.wall import WallSurface
 from ..mechanics.jaw_hold import fresh_start, hold_jaw
@@ -137,3 +138,39 @@ def spec_key(spec: EPMapSpec) -> str:
     if spec.extend_ms > 0:
         keep["extend_ms"] = spec.extend_ms
     return json.dumps(keep, sort_keys=True)
+
+
+def parse_ep(spec: str) -> tuple[str, dict[str, float]]:
+    """``JAW:MUSCLE=N[,MUSCLE=N]`` -> (jaw position, tongue forces in N)."""
+    jaw, sep, rest = spec.partition(":")
+    forces = {}
+    try:
+        for part in filter(None, rest.split(",")):
+            name, eq, value = part.partition("=")
+            if not eq:
+                raise ValueError
+            forces[name.strip()] = float(value)
+    except ValueError:
+        forces = None
+    if not sep or not jaw or forces is None or not forces or any(not np.isfinite(v) or v < 0 for v in forces.values()):
+        raise ArticError(f"--ep '{spec}' is not JAW:MUSCLE=N[,MUSCLE=N] (e.g. JO_0.5:SG=2.5) with forces >= 0 N; fix it")
+    return jaw, forces
+
+
+def map_ep_state(model: Model, maps, spec: str, options: EPMapSpec) -> tuple[State, dict[str, float]]:
+    """The whole state of one EP of the maps (``spec`` as :func:`parse_ep`), recomputed by holding its forces
+    as the map did; with the forces held (jaw and tongue, N)."""
+    jaw, forces = parse_ep(spec)
+    if jaw not in maps.jaws:
+        raise ArticError(f"--ep: the maps have no jaw position '{jaw}'; they have {', '.join(maps.jaws)}")
+    jm = maps.jaws[jaw]
+    nets = [n for fam in (jm.single, jm.pair, jm.group) for n in fam.values() if set(n.muscles) == set(forces)]
+    found = any(all(np.isclose(n.levels[n.muscles.index(k)], v).any() for k, v in forces.items()) for n in nets)
+    if not found:
+        have = ", ".join(f"{'+'.join(n.muscles)} at {'/'.join(f'{x:g}' for x in n.levels[0])} N"
+                         for n in list(jm.single.values())[:4])
+        raise ArticError(f"--ep '{spec}' is not an EP of the maps at {jaw} (e.g. {have}); give a muscle set and "
+                         "levels the maps hold")
+    start = jaw_rest(model, jm.forces)
+    state, _ = equilibrium_state(model, start, add_forces(jm.forces, forces), options)
+    return state, add_forces(jm.forces, forces)

@@ -140,13 +140,13 @@ class Candidate:
     detail: dict = field(default_factory=dict)  # cell and local coordinates (for refinement)
 
 
-def _settled_run(net: Net) -> int:
+def settled_run(net: Net) -> int:
     """How many levels of a vector, from 0 N up, settled (a vector is used up to its first unsettled EP)."""
     bad = np.flatnonzero(~net.converged)
     return int(bad[0]) if len(bad) else len(net.converged)
 
 
-def _polyline_nearest(pts: np.ndarray, target: np.ndarray):
+def polyline_nearest(pts: np.ndarray, target: np.ndarray):
     """Nearest point of a polyline (n, 2) to target: (distance, segment, fraction)."""
     a, b = pts[:-1], pts[1:]
     ab = b - a
@@ -156,7 +156,7 @@ def _polyline_nearest(pts: np.ndarray, target: np.ndarray):
     return float(d[k]), k, float(t[k])
 
 
-def _bilinear(c: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+def bilinear(c: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
     """c: (..., 4, d) corners (00, 10, 01, 11); u, v: (...)."""
     u, v = u[..., None], v[..., None]
     return (1 - u) * (1 - v) * c[..., 0, :] + u * (1 - v) * c[..., 1, :] + (1 - u) * v * c[..., 2, :] + u * v * c[..., 3, :]
@@ -170,7 +170,7 @@ def invert_cells(corners: np.ndarray, target: np.ndarray, iters: int = 12):
     v = np.full(len(corners), 0.5)
     p00, p10, p01, p11 = (corners[:, k] for k in range(4))
     for _ in range(iters):
-        r = _bilinear(corners, u, v) - target
+        r = bilinear(corners, u, v) - target
         du = (1 - v)[:, None] * (p10 - p00) + v[:, None] * (p11 - p01)
         dv = (1 - u)[:, None] * (p01 - p00) + u[:, None] * (p11 - p10)
         det = du[:, 0] * dv[:, 1] - du[:, 1] * dv[:, 0]
@@ -178,7 +178,7 @@ def invert_cells(corners: np.ndarray, target: np.ndarray, iters: int = 12):
         u = u - (dv[:, 1] * r[:, 0] - dv[:, 0] * r[:, 1]) / det
         v = v - (-du[:, 1] * r[:, 0] + du[:, 0] * r[:, 1]) / det
         u, v = np.clip(u, -0.5, 1.5), np.clip(v, -0.5, 1.5)
-    res = np.linalg.norm(_bilinear(corners, u, v) - target, axis=1)
+    res = np.linalg.norm(bilinear(corners, u, v) - target, axis=1)
     return u, v, res
 
 
@@ -233,11 +233,11 @@ class Problem:
     def singles(self) -> list[Candidate]:
         out = []
         for m, net in self.jm.single.items():
-            stop = _settled_run(net)
+            stop = settled_run(net)
             if stop < 2:
                 continue
             pts = net.x[:stop, :2, :2]
-            d, k, frac = _polyline_nearest(pts[:, self.c], self.goal)
+            d, k, frac = polyline_nearest(pts[:, self.c], self.goal)
             if d > self.reach:
                 continue
             lv = net.levels[0]
@@ -263,7 +263,7 @@ class Problem:
             u, v, _ = invert_cells(corners[:, :, self.c], self.goal)
             # outside a cell, its nearest edge point (Newton's solution clipped) may still be within tolerance
             u, v = np.clip(u, 0.0, 1.0), np.clip(v, 0.0, 1.0)
-            res = np.linalg.norm(_bilinear(corners[:, :, self.c], u, v) - self.goal, axis=1)
+            res = np.linalg.norm(bilinear(corners[:, :, self.c], u, v) - self.goal, axis=1)
             inside = res <= self.reach
             for k in np.flatnonzero(inside):
                 a, b = muscles[-2], muscles[-1]
@@ -274,7 +274,7 @@ class Problem:
                 forces[b] = forces.get(b, 0.0) + fb
                 if fixed is not None:
                     forces[fixed[0]] = forces.get(fixed[0], 0.0) + fixed[1]
-                pred = _bilinear(corners[k].reshape(1, 4, 4), np.array([u[k]]), np.array([v[k]]))[0].reshape(2, 2)
+                pred = bilinear(corners[k].reshape(1, 4, 4), np.array([u[k]]), np.array([v[k]]))[0].reshape(2, 2)
                 label = name if fixed is None else f"{name} ({fixed[0]} {fixed[1]:g} N)"
                 out.append(self._candidate(family, label, forces, pred,
                                            {"cell": [int(ii[k]), int(jj[k])], "uv": [float(u[k]), float(v[k])],
@@ -285,10 +285,10 @@ class Problem:
         """Closest point of the mapped region to the crucial target (vectors exactly, net cells sampled)."""
         best = (None, np.inf, "")
         for m, net in self.jm.single.items():
-            pts = net.x[: _settled_run(net), self.c, :2]
+            pts = net.x[: settled_run(net), self.c, :2]
             if len(pts) < 2:
                 continue
-            d, k, frac = _polyline_nearest(pts, self.goal)
+            d, k, frac = polyline_nearest(pts, self.goal)
             if d < best[1]:
                 best = (pts[k] + frac * (pts[k + 1] - pts[k]), d, f"vector {m}")
         s = np.linspace(0, 1, 9)
@@ -298,7 +298,7 @@ class Problem:
             if not len(corners):
                 continue
             c = np.repeat(corners[:, :, self.c][:, None], len(uu), axis=1)  # (C, S, 4, 2)
-            p = _bilinear(c, np.broadcast_to(uu, c.shape[:2]), np.broadcast_to(vv, c.shape[:2]))
+            p = bilinear(c, np.broadcast_to(uu, c.shape[:2]), np.broadcast_to(vv, c.shape[:2]))
             d = np.linalg.norm(p - self.goal, axis=-1)
             k = np.unravel_index(np.argmin(d), d.shape)
             if d[k] < best[1]:

@@ -116,7 +116,7 @@ def solve_acoustic(ctx: Context, target: TargetSpec, voicer=None, verify: bool =
     """An acoustic target: candidates from the EPs' formants, checked (``verify``) or corrected (``refine``)
     by ``voicer.voice(jaw_forces, forces, lips, port) -> dict(formants_hz, reached_cm, area_function)``."""
     from .acoustic_solver import nearest_candidate, solve_acoustic_on, within
-    from .verify import _free, _map_jacobian, broyden, top_force
+    from .verify import free_forces, map_jacobian, broyden, top_force
     from ..units import hz_to_bark
 
     if ctx.formants is None:
@@ -180,8 +180,8 @@ def solve_acoustic(ctx: Context, target: TargetSpec, voicer=None, verify: bool =
     for k, cand in enumerate(cands[:REFINE_TRIES]):
         if k > 0 and left < 2:
             break
-        free = _free(cand)
-        r = broyden(measure, _map_jacobian(jm, cand, free, feature), cand.forces, free, goal,
+        free = free_forces(cand)
+        r = broyden(measure, map_jacobian(jm, cand, free, feature), cand.forces, free, goal,
                     lambda e, v: within(target, v["formants_hz"], AIM), left,
                     first=(measure(cand.forces) if k > 0 else (hz_to_bark(np.asarray(first["formants_hz"][:2])), first)),
                     upper=top_force(jm))

@@ -65,7 +65,7 @@ class Refinement:
     history: list[dict] = field(default_factory=list)
 
 
-def _free(candidate: Candidate) -> list[str]:
+def free_forces(candidate: Candidate) -> list[str]:
     if candidate.family == "single":
         return [candidate.name]  # (its force may be 0: the jaw position's rest)
     net = candidate.detail["net"]
@@ -73,7 +73,7 @@ def _free(candidate: Candidate) -> list[str]:
     return [a, b]
 
 
-def _map_jacobian(jm: JawMaps, candidate: Candidate, free: list[str], feature) -> np.ndarray:
+def map_jacobian(jm: JawMaps, candidate: Candidate, free: list[str], feature) -> np.ndarray:
     """d(feature)/d(free forces) (2, n) from the map around the candidate; ``feature(family, net_name, x)``
     gives the (..., 2) feature of a net's EPs (x: the net's control points)."""
     if candidate.family == "single":
@@ -176,8 +176,8 @@ def refine(sim: Simulator, jm: JawMaps, jaw_forces: dict[str, float], candidate:
            goal: np.ndarray, tolerance: float, budget: int = 8, first: np.ndarray | None = None) -> Refinement:
     """Correct the candidate's free forces until the simulated crucial point is within ``tolerance``."""
     c = CONTROL_POINTS.index(crucial)
-    free = _free(candidate)
-    jac = _map_jacobian(jm, candidate, free, lambda family, name, x: x[..., c, :2])
+    free = free_forces(candidate)
+    jac = map_jacobian(jm, candidate, free, lambda family, name, x: x[..., c, :2])
 
     def measure(forces):
         x = sim.reach(jaw_forces, forces)

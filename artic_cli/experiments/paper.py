@@ -12,7 +12,8 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from ..geometry.wall import PARTS
-from ..mechanics.contact import closest_on_triangles, farthest_beyond_wall, wall_query
+from ..mechanics.contact import farthest_beyond_wall
+from ..mechanics.wall_query import closest_on_triangles, wall_query
 from ..mechanics.jaw_hold import fresh_start, hold_jaw
 from ..mechanics.loads import control_from_newtons
 from ..mechanics.model import Model

@@ -332,8 +332,8 @@ class NodeAssembly:
 
     def blocks(self, n_nodes: int, cyl: tuple, k_cyl: np.ndarray, bricks: np.ndarray, grad: np.ndarray,
                w: np.ndarray, seg: tuple, k_seg: np.ndarray) -> np.ndarray:
-        """Node-level blocks (numpy; :func:`..kernels.node_blocks` computes the same in one loop):
-        two-node elements (i, j) with 3x3 blocks k give k on both diagonals and -k on their pair;
+        """Node-level blocks (numpy; the terms' compiled loops :func:`.elements.cylinder_blocks`,
+        :func:`.volume.brick_blocks` and :func:`.muscles.segment_blocks` compute the same): two-node elements (i, j) with 3x3 blocks k give k on both diagonals and -k on their pair;
         bricks give w g_a g_b^T for every two corners (``grad`` (B,8,3))."""
         p = self.n_pairs
         out = np.zeros((p + n_nodes, 3, 3))

@@ -31,10 +31,9 @@ from functools import cached_property, lru_cache
 
 import numpy as np
 
-from . import kernels
-
-USE_KERNELS = True  # compiled loops (numba) when available; the numpy path gives the same numbers
 import scipy.sparse as sp
+
+from ..jit import compiled, njit
 
 
 @dataclass(frozen=True)
@@ -116,8 +115,8 @@ def youngs_modulus(cyl: CylinderSet, strain: np.ndarray) -> tuple[np.ndarray, np
 
 
 def evaluate(cyl: CylinderSet, x: np.ndarray) -> CylinderState:
-    if kernels.AVAILABLE and USE_KERNELS:
-        n, length, strain, shrink, e, de, elastic = kernels.cylinder_state(
+    if compiled():
+        n, length, strain, shrink, e, de, elastic = cylinder_state(
             np.ascontiguousarray(x), cyl.i, cyl.j, cyl.l0, cyl.area0, cyl.youngs, cyl.poisson, cyl.knee, cyl.rate,
             cyl.slack_strain)
         return CylinderState(n=n, length=length, strain=strain, elastic=elastic, shrink=shrink, e=e, de=de)
@@ -156,9 +155,9 @@ def damping_frame(cyl: CylinderSet, x: np.ndarray) -> DampingFrame:
 def nodal_forces(cyl: CylinderSet, cs: CylinderState, frame: DampingFrame | None, v: np.ndarray | None,
                  scatter) -> np.ndarray:
     """(N,3) nodal forces of all cylinders (elastic, plus the dashpots along ``frame`` at velocities ``v``)."""
-    if kernels.AVAILABLE and USE_KERNELS:
+    if compiled():
         damped = frame is not None and v is not None
-        return kernels.cylinder_forces(cs.n, cs.elastic, cyl.i, cyl.j, frame.n if damped else cs.n,
+        return cylinder_forces(cs.n, cs.elastic, cyl.i, cyl.j, frame.n if damped else cs.n,
                                        frame.c if damped else cs.length, np.ascontiguousarray(v) if damped else cs.n,
                                        cyl.n_nodes, damped)
     return scatter @ axial_forces(cyl, cs, frame, v)
@@ -193,3 +192,101 @@ def strain_energy(cyl: CylinderSet, strain: np.ndarray, points: int = 8) -> np.n
         density = np.where(st / dd < 1.0, st**2 / 2.0 - st**3 / (6.0 * dd), dd**2 / 3.0 + dd * (st - dd) / 2.0)
         energy[slack] = (cyl.area0 * cyl.l0 * np.broadcast_to(cyl.youngs, strain.shape))[slack] * density
     return energy
+
+
+# --- compiled loops (numba): the same numbers as the numpy path above ---------------------------------
+
+@njit(cache=True, fastmath=False)
+def cylinder_state(x, ci, cj, l0, area0, youngs, poisson, knee, rate, slack):
+    """Per cylinder: unit axis n (C,3), length, strain, shrink, E, dE/de, elastic tension (the slack law
+    as elements.youngs_modulus)."""
+    c = len(ci)
+    n = np.empty((c, 3))
+    length = np.empty(c)
+    strain = np.empty(c)
+    shrink = np.empty(c)
+    e = np.empty(c)
+    de = np.empty(c)
+    elastic = np.empty(c)
+    for k in range(c):
+        a, b = ci[k], cj[k]
+        d0 = x[b, 0] - x[a, 0]
+        d1 = x[b, 1] - x[a, 1]
+        d2 = x[b, 2] - x[a, 2]
+        ln = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        length[k] = ln
+        n[k, 0] = d0 / ln
+        n[k, 1] = d1 / ln
+        n[k, 2] = d2 / ln
+        s = ln / l0[k] - 1.0
+        strain[k] = s
+        sh = 1.0 - poisson[k] * s
+        if sh < 0.05:
+            sh = 0.05
+        shrink[k] = sh
+        over = s - knee[k]
+        if abs(slack[k]) < np.inf and s * slack[k] > 0.0:  # the side the link gives way on
+            if s / slack[k] >= 1.0:
+                e[k] = youngs[k] * slack[k] / (2.0 * s)
+                de[k] = -youngs[k] * slack[k] / (2.0 * s * s)
+            else:
+                e[k] = youngs[k] * (1.0 - s / (2.0 * slack[k]))
+                de[k] = -youngs[k] / (2.0 * slack[k])
+        elif over > 0.0:
+            g = min(rate[k] * over, 50.0)
+            ek = youngs[k] * np.exp(g)
+            e[k] = ek
+            de[k] = rate[k] * ek
+        else:
+            e[k] = youngs[k]
+            de[k] = 0.0
+        elastic[k] = e[k] * s * area0[k] * sh * sh
+    return n, length, strain, shrink, e, de, elastic
+
+
+@njit(cache=True, fastmath=False)
+def cylinder_forces(n, elastic, ci, cj, frame_n, frame_c, v, n_nodes, with_damping):
+    """Nodal forces (N,3) of the cylinders: elastic tension along n, dashpot along the step's frame."""
+    f = np.zeros((n_nodes, 3))
+    for k in range(len(ci)):
+        a, b = ci[k], cj[k]
+        t = elastic[k]
+        g0 = t * n[k, 0]
+        g1 = t * n[k, 1]
+        g2 = t * n[k, 2]
+        if with_damping:
+            r = (frame_n[k, 0] * (v[b, 0] - v[a, 0]) + frame_n[k, 1] * (v[b, 1] - v[a, 1])
+                 + frame_n[k, 2] * (v[b, 2] - v[a, 2])) * frame_c[k]
+            g0 += r * frame_n[k, 0]
+            g1 += r * frame_n[k, 1]
+            g2 += r * frame_n[k, 2]
+        f[a, 0] += g0
+        f[a, 1] += g1
+        f[a, 2] += g2
+        f[b, 0] -= g0
+        f[b, 1] -= g1
+        f[b, 2] -= g2
+    return f
+
+
+@njit(cache=True, fastmath=False)
+def cylinder_blocks(out, n, length, elastic, axial, frame_n, frame_c, c_v, signed, ci, cj, cyl_pair, n_pairs):
+    """Adds each cylinder's tangent to the node-level blocks ``out`` (P + N, 3, 3; pairs i < j, then the
+    diagonals): k = (K_ax - T/l) n n^T + T/l I + c_v c n0 n0^T on both diagonals, -k on their pair."""
+    k3 = np.empty((3, 3))
+    for k in range(len(length)):
+        t = elastic[k] if signed else max(elastic[k], 0.0)
+        kg = t / length[k]
+        kn = max(axial[k], 0.0) - kg
+        cv = c_v * frame_c[k]
+        for p in range(3):
+            for q in range(3):
+                k3[p, q] = kn * n[k, p] * n[k, q] + cv * frame_n[k, p] * frame_n[k, q]
+            k3[p, p] += kg
+        a, b, m = n_pairs + ci[k], n_pairs + cj[k], cyl_pair[k]
+        for p in range(3):
+            for q in range(3):
+                out[a, p, q] += k3[p, q]
+                out[b, p, q] += k3[p, q]
+                out[m, p, q] -= k3[p, q]
+    return out

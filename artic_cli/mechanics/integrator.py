@@ -22,14 +22,16 @@ from dataclasses import replace
 import numpy as np
 
 from ..errors import ArticError
-from . import elements, kernels
+from . import elements
+from ..jit import compiled
 from .assembly import add_low_rank, factorize
 from .contact import ContactPlanes, contact_planes, enforce
+from .elements import cylinder_blocks
 from .model import Control, Model, State
 from .penalty import ramp
-from .muscles import FibreState, fibre_state, fibre_stiffness, length_gradients, muscle_forces
+from .muscles import FibreState, fibre_state, fibre_stiffness, length_gradients, muscle_forces, segment_blocks
 from ..geometry.hexahedra import SHAPE_GRADIENTS_CORNER, SHAPE_GRADIENTS_GAUSS
-from .volume import GUARD_FRACTION, corner_guard, volume_forces
+from .volume import GUARD_FRACTION, brick_blocks, brick_terms, corner_guard, volume_forces
 
 _EYE = np.eye(3)
 _MAX_INCREMENT = 0.2  # cm: the largest node move one Newton iteration may make
@@ -49,9 +51,9 @@ def internal_forces(model: Model, x: np.ndarray, v: np.ndarray | None = None,
     f = elements.nodal_forces(model.springs, cs, frame, v, model.scatter)
     grad = vol = None
     nt = model.n_tongue
-    if kernels.AVAILABLE and elements.USE_KERNELS and model.corner_j0 is not None:
+    if compiled() and model.corner_j0 is not None:
         kappa = model.kappa if model.volume_constraint else np.zeros_like(model.kappa)
-        fb, vol, grad, pairs, g, w = kernels.brick_terms(
+        fb, vol, grad, pairs, g, w = brick_terms(
             np.ascontiguousarray(x[:nt]), model.bricks, SHAPE_GRADIENTS_GAUSS, SHAPE_GRADIENTS_CORNER, model.brick_v0, kappa,
             model.corner_j0, model.guard_weight, GUARD_FRACTION)
         f[:nt] += fb
@@ -148,10 +150,12 @@ def tangent(model: Model, cs: elements.CylinderState, frame: elements.DampingFra
         k_seg = np.zeros((0, 3, 3))
         seg_pair = np.zeros(0, dtype=np.int64)
         seg = (seg_pair, seg_pair)
-    if kernels.AVAILABLE and elements.USE_KERNELS:
-        blocks = kernels.node_blocks(cs.n, cs.length, cs.elastic, axial, frame.n, frame.c, c_v, signed_geometry,
-                                     cyl.i, cyl.j, asm.cyl_pair, model.bricks, asm.brick_pair, grad, w,
-                                     seg[0], seg[1], seg_pair, k_seg, asm.n_pairs, model.n_nodes)
+    if compiled():
+        blocks = np.zeros((asm.n_pairs + model.n_nodes, 3, 3))
+        cylinder_blocks(blocks, cs.n, cs.length, cs.elastic, axial, frame.n, frame.c, c_v, signed_geometry, cyl.i,
+                        cyl.j, asm.cyl_pair, asm.n_pairs)
+        brick_blocks(blocks, model.bricks, asm.brick_pair, grad, w, asm.n_pairs)
+        segment_blocks(blocks, seg[0], seg[1], seg_pair, k_seg, asm.n_pairs)
     else:
         k_geo = (cs.elastic if signed_geometry else np.maximum(cs.elastic, 0.0)) / cs.length
         k_nn = np.maximum(axial, 0.0) - k_geo

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from . import elements, kernels
+from ..jit import compiled, njit
 
 FL_COEFFS = (22.5, 3.498, -14.718, 1.98, 0.858)  # Eq. (9), highest power first
 FL_RANGE = (-0.185, 0.49)
@@ -121,10 +121,10 @@ class FibreState:
 def fibre_state(ms: MuscleSet, x: np.ndarray, activation: np.ndarray, sigma2_prev: np.ndarray,
                 strain_prev: np.ndarray, h: float) -> FibreState:
     """Tensions for positions ``x``, muscle forces ``activation`` (M,) in dyn, after a step ``h``."""
-    if kernels.AVAILABLE and elements.USE_KERNELS:
-        n, length, total = kernels.fibre_geometry(np.ascontiguousarray(x), ms.seg_i, ms.seg_j, ms.seg_fibre,
+    if compiled():
+        n, length, total = fibre_geometry(np.ascontiguousarray(x), ms.seg_i, ms.seg_j, ms.seg_fibre,
                                                   ms.n_fibres)
-        strain, sigma2, tension = kernels.fibre_tensions(
+        strain, sigma2, tension = fibre_tensions(
             total, ms.fibre_l0, sigma2_prev, strain_prev, float(h), ms.k1, ms.k2, ms.b2,
             np.asarray(activation, dtype=float), ms.fibre_muscle, ms.fibre_share, ms.fibre_area, ms.fl_width,
             _FL, *FL_RANGE)
@@ -156,8 +156,8 @@ def length_gradients(ms: MuscleSet, fs: FibreState, fibres: np.ndarray, n_nodes:
     """(3N, len(fibres)) gradient of each chosen fibre's length with respect to the node positions."""
     col = np.full(ms.n_fibres, -1)
     col[fibres] = np.arange(len(fibres))
-    if kernels.AVAILABLE and elements.USE_KERNELS:
-        return kernels.fibre_gradients(fs.n, ms.seg_i, ms.seg_j, col[ms.seg_fibre], n_nodes,
+    if compiled():
+        return fibre_gradients(fs.n, ms.seg_i, ms.seg_j, col[ms.seg_fibre], n_nodes,
                                        len(fibres)).reshape(3 * n_nodes, -1)
     g = np.zeros((n_nodes, 3, len(fibres)))
     seg = np.flatnonzero(col[ms.seg_fibre] >= 0)
@@ -187,15 +187,15 @@ def fibre_twins(ms: MuscleSet, image: np.ndarray) -> np.ndarray | None:
 
 def muscle_forces(ms: MuscleSet, fs: FibreState) -> np.ndarray:
     """(N,3) nodal forces of all fibres."""
-    if kernels.AVAILABLE and elements.USE_KERNELS:
-        return kernels.fibre_forces(fs.n, fs.tension, ms.seg_i, ms.seg_j, ms.seg_fibre, ms.scatter.shape[0])
+    if compiled():
+        return fibre_forces(fs.n, fs.tension, ms.seg_i, ms.seg_j, ms.seg_fibre, ms.scatter.shape[0])
     return ms.scatter @ (fs.tension[ms.seg_fibre][:, None] * fs.n)
 
 
 def fibre_lengths(ms: MuscleSet, x: np.ndarray) -> np.ndarray:
     """(F,) length of every fibre, cm."""
-    if kernels.AVAILABLE and elements.USE_KERNELS:
-        return kernels.fibre_geometry(np.ascontiguousarray(x), ms.seg_i, ms.seg_j, ms.seg_fibre, ms.n_fibres)[2]
+    if compiled():
+        return fibre_geometry(np.ascontiguousarray(x), ms.seg_i, ms.seg_j, ms.seg_fibre, ms.n_fibres)[2]
     d = ms.diff @ x
     return ms.seg_sum @ np.sqrt((d * d).sum(axis=1))
 
@@ -212,3 +212,94 @@ def muscle_tensions(ms: MuscleSet, x: np.ndarray, activation: np.ndarray, sigma2
     passive = ms.k1 * np.maximum(strain, 0.0) * strain + sigma2
     t = activation[ms.fibre_muscle] * ms.fibre_share * force_length(strain, ms.fl_width) + ms.fibre_area * passive
     return np.bincount(ms.fibre_muscle, weights=t, minlength=len(ms.names))
+
+
+# --- compiled loops (numba): the same numbers as the numpy path above ---------------------------------
+
+@njit(cache=True, fastmath=False)
+def fibre_geometry(x, seg_i, seg_j, seg_fibre, n_fibres):
+    """Segment unit vectors (S,3), segment lengths (S,) and fibre lengths (F,)."""
+    s = len(seg_i)
+    n = np.empty((s, 3))
+    length = np.empty(s)
+    total = np.zeros(n_fibres)
+    for k in range(s):
+        a, b = seg_i[k], seg_j[k]
+        d0 = x[b, 0] - x[a, 0]
+        d1 = x[b, 1] - x[a, 1]
+        d2 = x[b, 2] - x[a, 2]
+        ln = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        length[k] = ln
+        n[k, 0] = d0 / ln
+        n[k, 1] = d1 / ln
+        n[k, 2] = d2 / ln
+        total[seg_fibre[k]] += ln
+    return n, length, total
+
+
+@njit(cache=True, fastmath=False)
+def fibre_forces(n, tension, seg_i, seg_j, seg_fibre, n_nodes):
+    """(N,3) nodal forces of fibres pulling with ``tension`` (F,) along their segments."""
+    f = np.zeros((n_nodes, 3))
+    for k in range(len(seg_i)):
+        t = tension[seg_fibre[k]]
+        for i in range(3):
+            f[seg_i[k], i] += t * n[k, i]
+            f[seg_j[k], i] -= t * n[k, i]
+    return f
+
+
+@njit(cache=True, fastmath=False)
+def fibre_gradients(n, seg_i, seg_j, seg_col, n_nodes, r):
+    """(N,3,r) gradient of fibre lengths: column ``seg_col[k]`` (-1: none) gets +n at seg_j, -n at seg_i."""
+    g = np.zeros((n_nodes, 3, r))
+    for k in range(len(seg_i)):
+        c = seg_col[k]
+        if c < 0:
+            continue
+        for i in range(3):
+            g[seg_j[k], i, c] += n[k, i]
+            g[seg_i[k], i, c] -= n[k, i]
+    return g
+
+
+@njit(cache=True, fastmath=False, error_model="numpy")
+def fibre_tensions(total, l0, sigma2_prev, strain_prev, h, k1, k2, b2, activation, fibre_muscle, share, area,
+                   width, coeffs, lo, hi):
+    """Strain, Maxwell stress and tension of every fibre (:func:`..muscles.fibre_state`'s numbers) from its
+    length ``total``; ``coeffs`` Eq. (9) highest power first, zero outside ``lo < e / width < hi``."""
+    nf = len(total)
+    strain = np.empty(nf)
+    sigma2 = np.empty(nf)
+    tension = np.empty(nf)
+    relax = 1.0 + h * k2 / b2 if h > 0 else 1.0
+    for f in range(nf):
+        e = total[f] / l0[f] - 1.0
+        s2 = (sigma2_prev[f] + k2 * (e - strain_prev[f])) / relax if h > 0 else sigma2_prev[f]
+        passive = k1 * max(e, 0.0) * e + s2
+        u = e / width
+        fl = 0.0
+        if lo < u < hi:
+            p = coeffs[0]
+            for c in coeffs[1:]:
+                p = p * u + c
+            fl = max(p / coeffs[-1], 0.0)
+        strain[f] = e
+        sigma2[f] = s2
+        tension[f] = activation[fibre_muscle[f]] * share[f] * fl + area[f] * passive
+    return strain, sigma2, tension
+
+
+@njit(cache=True, fastmath=False)
+def segment_blocks(out, seg_i, seg_j, seg_pair, seg_k, n_pairs):
+    """Adds each fibre segment's own 3x3 block ``seg_k`` to the node-level blocks ``out`` (P + N, 3, 3), as
+    a cylinder's: on both diagonals, minus on its pair."""
+    for k in range(len(seg_pair)):
+        a, b, m = n_pairs + seg_i[k], n_pairs + seg_j[k], seg_pair[k]
+        for p in range(3):
+            for q in range(3):
+                v = seg_k[k, p, q]
+                out[a, p, q] += v
+                out[b, p, q] += v
+                out[m, p, q] -= v
+    return out

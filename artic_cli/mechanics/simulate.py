@@ -219,3 +219,23 @@ def hold(model: Model, state: State, control: Control, duration: float, watch: n
                 if stop_below is not None and drift < stop_below:
                     break
     return Hold(state=state, drift=drift, stopped=state.t - t0)
+
+
+VOLUME_LIMIT = 0.01  # a run with the volume constraint on that changes the tongue's volume more than this is not physical
+
+
+def problems(traj: Trajectory, volume_constraint: bool) -> list[str]:
+    """Why a trajectory is not physical (empty when it is): NaN, inverted bricks, a failed step, or (with the
+    volume constraint on) a volume change above 1 %."""
+    out = []
+    if traj.stats.get("failure"):
+        out.append(traj.stats["failure"])
+    if not np.isfinite(traj.x).all():
+        out.append("positions are not finite (NaN)")
+    if int(traj.inverted.max()) > 0:
+        k = int(np.argmax(traj.inverted > 0))
+        out.append(f"{int(traj.inverted.max())} inverted bricks (first at {traj.time[k] * 1e3:.0f} ms)")
+    vol = float(np.nanmax(np.abs(traj.volume_change)))
+    if volume_constraint and not vol <= VOLUME_LIMIT:
+        out.append(f"tongue volume changed by {100 * vol:.2f} % (limit {100 * VOLUME_LIMIT:g} %)")
+    return out

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..jit import njit
 from ..geometry.hexahedra import corner_jacobians, corner_jacobians_at, volume_gradients, volumes
 
 # Inversion guard: a corner whose Jacobian falls below this fraction f of its rest value is pushed back by
@@ -60,3 +61,119 @@ def corner_guard(x: np.ndarray, bricks: np.ndarray, j0: np.ndarray, weight: np.n
     contrib = (weight[b] * depth**2 / GUARD_FRACTION)[:, None, None] * g  # -dU/dx
     np.add.at(f, bricks[b], contrib)
     return f, (b, c, g, 2.0 * weight[b] * depth / GUARD_FRACTION)
+
+
+# --- compiled loops (numba): the same numbers as the numpy path above ---------------------------------
+
+@njit(cache=True, fastmath=False)
+def _jacobian_det(xl, dn, jac, cof):
+    """det of a brick's Jacobian at one reference point (corner coordinates ``xl`` (8,3), shape gradients
+    ``dn`` (8,3)); fills ``jac`` (its columns, jac[l, i]) and ``cof`` (d det / d column l = cross of the
+    other two columns)."""
+    for l in range(3):
+        j0 = 0.0
+        j1 = 0.0
+        j2 = 0.0
+        for a in range(8):
+            d = dn[a, l]
+            if d != 0.0:  # at a corner only 2 of 8 shape gradients are non-zero per direction
+                j0 += xl[a, 0] * d
+                j1 += xl[a, 1] * d
+                j2 += xl[a, 2] * d
+        jac[l, 0] = j0
+        jac[l, 1] = j1
+        jac[l, 2] = j2
+    for i in range(3):
+        i1, i2 = (i + 1) % 3, (i + 2) % 3
+        cof[0, i] = jac[1, i1] * jac[2, i2] - jac[1, i2] * jac[2, i1]
+        cof[1, i] = jac[2, i1] * jac[0, i2] - jac[2, i2] * jac[0, i1]
+        cof[2, i] = jac[0, i1] * jac[1, i2] - jac[0, i2] * jac[1, i1]
+    return jac[0, 0] * cof[0, 0] + jac[0, 1] * cof[0, 1] + jac[0, 2] * cof[0, 2]
+
+
+@njit(cache=True, fastmath=False)
+def brick_terms(x, bricks, dn_gauss, dn_corner, v0, kappa, j0, guard_w, fraction):
+    """Volume penalty and inversion guard of every brick in one pass.
+
+    Returns forces (N,3), volumes (B,), dV/dx (B,8,3), the guarded (brick, corner) pairs (K,2), their
+    d(J/J0)/dx (K,8,3) and weights (K,).  Same formulas as :mod:`.volume` and :mod:`..geometry.hexahedra`.
+    """
+    nb = bricks.shape[0]
+    f = np.zeros_like(x)
+    vol = np.zeros(nb)
+    grad = np.zeros((nb, 8, 3))
+    gk = []
+    gg = []
+    gw = []
+    jac = np.empty((3, 3))
+    cof = np.empty((3, 3))
+    xl = np.empty((8, 3))
+    for b in range(nb):
+        for a in range(8):
+            for i in range(3):
+                xl[a, i] = x[bricks[b, a], i]
+        for g in range(dn_gauss.shape[0]):
+            det = _jacobian_det(xl, dn_gauss[g], jac, cof)
+            vol[b] += det
+            for a in range(8):
+                for i in range(3):
+                    grad[b, a, i] += (cof[0, i] * dn_gauss[g, a, 0] + cof[1, i] * dn_gauss[g, a, 1]
+                                      + cof[2, i] * dn_gauss[g, a, 2])
+        scale = -kappa[b] * (vol[b] - v0[b]) / v0[b]
+        if scale != 0.0:
+            for a in range(8):
+                for i in range(3):
+                    f[bricks[b, a], i] += scale * grad[b, a, i]
+        if guard_w.shape[0] == 0:
+            continue
+        for c in range(8):
+            det = _jacobian_det(xl, dn_corner[c], jac, cof)
+            ratio = det / j0[b, c]
+            if ratio < fraction:
+                gc = np.empty((8, 3))
+                for a in range(8):
+                    for i in range(3):
+                        gc[a, i] = (cof[0, i] * dn_corner[c, a, 0] + cof[1, i] * dn_corner[c, a, 1]
+                                    + cof[2, i] * dn_corner[c, a, 2]) / j0[b, c]
+                w = guard_w[b]
+                depth = fraction - ratio
+                push = w * depth * depth / fraction
+                for a in range(8):
+                    for i in range(3):
+                        f[bricks[b, a], i] += push * gc[a, i]
+                gk.append((b, c))
+                gg.append(gc)
+                gw.append(2.0 * w * depth / fraction)
+    k = len(gk)
+    pairs = np.empty((k, 2), dtype=np.int64)
+    gout = np.empty((k, 8, 3))
+    wout = np.empty(k)
+    for m in range(k):
+        pairs[m, 0] = gk[m][0]
+        pairs[m, 1] = gk[m][1]
+        gout[m] = gg[m]
+        wout[m] = gw[m]
+    return f, vol, grad, pairs, gout, wout
+
+
+@njit(cache=True, fastmath=False)
+def brick_blocks(out, bricks, brick_pair, grad, brick_w, n_pairs):
+    """Adds w g_a g_b^T for every two corners of every brick (the Gauss-Newton volume tangent; ``grad``
+    (B,8,3)) to the node-level blocks ``out`` (P + N, 3, 3)."""
+    for e in range(grad.shape[0]):
+        w = brick_w[e]
+        for a in range(8):
+            na = bricks[e, a]
+            for b in range(8):
+                nb = bricks[e, b]
+                if na < nb:
+                    m = brick_pair[e, a, b]
+                elif a == b:
+                    m = n_pairs + na
+                else:
+                    continue
+                for p in range(3):
+                    wp = w * grad[e, a, p]
+                    for q in range(3):
+                        out[m, p, q] += wp * grad[e, b, q]
+    return out

@@ -31,7 +31,7 @@ def animate_simulation(traj, model, wall, path: Path | str, fps: int = 20, max_f
     jaw_line = ax.plot([], [], color=WALL_STYLE["mandible"], lw=2.0)[0]
     jaw_xy = None
     if model.contact is not None:
-        from ..mechanics.contact import rigid_motion
+        from ..mechanics.wall_query import rigid_motion
 
         xy = wall_outlines(wall, 0.0)["mandible"]
         jaw_xy = np.column_stack([xy, np.zeros(len(xy))])

@@ -14,7 +14,7 @@ def plot_simulation(traj, model, wall, path: Path | str, title: str = "") -> Pat
     fig, ax = plt.subplots(figsize=(7.5, 7.5))
     draw_wall(ax, wall, lateral=False, parts=("palate", "pharynx") if model.contact is not None else None)
     if model.contact is not None:  # the mandible's wall moves with the jaw
-        from ..mechanics.contact import rigid_motion
+        from ..mechanics.wall_query import rigid_motion
 
         xy = wall_outlines(wall, 0.0)["mandible"]
         pts = np.column_stack([xy, np.zeros(len(xy))])

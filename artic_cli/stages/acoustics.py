@@ -3,14 +3,10 @@ frame of a vocal-tract file (section II.A's vocal tract as an area function)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
 
-from ..acoustics.formants import formants
-from ..acoustics.model import air_of, frequencies, tract_of
-from ..acoustics.transfer import radiated_pressure, transfer
+from ..acoustics.analysis import Acoustics, analyse
 from ..acoustics.tube import Tube, read_tube_csv
 from ..config import Config, load_config
 from ..errors import ArticError
@@ -23,52 +19,11 @@ STAGE = Stage(name="acoustics", module=__name__, sections=("acoustics",), kind="
               hint="rerun 'artic acoustics'")
 
 
-@dataclass
-class Acoustics:
-    """Frames x frequencies: the transfer function U_lips / U_glottis and the radiated pressure (dB), and
-    frames x formants: their frequencies and -3 dB bandwidths (Hz; NaN where there are fewer peaks)."""
-
-    frequency_hz: np.ndarray  # (F,)
-    transfer_db: np.ndarray  # (T, F)
-    pressure_db: np.ndarray  # (T, F)
-    formants_hz: np.ndarray  # (T, K)
-    bandwidths_hz: np.ndarray  # (T, K)
-    time_s: np.ndarray | None = None  # (T,) for a time series
-    min_area_cm2: np.ndarray | None = None  # (T,) each frame's smallest section (near 0: a closure)
-
-
 def compute(tubes: list[Tube], cfg: Config, lossless: bool = False, velum_area_cm2=None,
             port_from_glottis_cm=None, progress=None, spectra: bool = True, bandwidths: bool = True) -> Acoustics:
-    """Every tube's acoustics; ``velum_area_cm2`` and ``port_from_glottis_cm``: one value for all tubes or one
-    per tube (None: the config's port area, and its distance from the lips for a plain tube).  ``spectra=False``:
-    formants and bandwidths only (the stored transfer function and pressure spectrum are half the work; their
-    arrays are then empty); ``bandwidths=False``: NaN bandwidths (a third of the formant search)."""
-    ac = STAGE.view(cfg).acoustics
-    air = air_of(ac, lossless)
-    f = frequencies(ac)
-    tf, pr, fm, bw = [], [], [], []
-    per = lambda v, k: v[k] if isinstance(v, (list, tuple, np.ndarray)) else v  # noqa: E731
-    for k, tube in enumerate(tubes):
-        if progress is not None:
-            progress(k, len(tubes))
-        velum, port = per(velum_area_cm2, k), per(port_from_glottis_cm, k)
-        tract = tract_of(tube, ac, None if velum is None else float(velum), lossless,
-                         None if port is None else float(port))
-        if spectra:
-            h = transfer(tract, f, air)
-            tf.append(20 * np.log10(np.maximum(np.abs(h), 1e-12)))
-            pr.append(20 * np.log10(np.maximum(np.abs(radiated_pressure(h, f, air)), 1e-30) / 2e-4))
-        fk, bk = formants(lambda x, t=tract: np.abs(transfer(t, x, air)), ac.max_frequency_hz,
-                          ac.formant_search_step_hz, ac.formants, lossless=lossless, bandwidths=bandwidths)
-        fm.append(fk)
-        bw.append(bk)
-    if progress is not None:
-        progress(len(tubes), len(tubes))
-    if not spectra:
-        f = np.zeros(0)
-        tf = pr = np.zeros((len(tubes), 0))
-    return Acoustics(f, np.array(tf), np.array(pr), np.array(fm), np.array(bw),
-                     min_area_cm2=np.array([float(np.min(t.area_cm2)) for t in tubes]))
+    """:func:`artic_cli.acoustics.analysis.analyse` with the stage's config section."""
+    return analyse(tubes, STAGE.view(cfg).acoustics, lossless, velum_area_cm2, port_from_glottis_cm, progress,
+                   spectra, bandwidths)
 
 
 def write(path: Path | str, result: Acoustics, prov=None, extra: dict | None = None) -> None:
@@ -118,21 +73,13 @@ def tube_acoustics(tube: Path | str, config: Path | str | None = None, lossless:
     return result
 
 
-def port_positions(tracts) -> np.ndarray:
-    """Per frame, where the nasal branch joins: the start of the velum region, cm from the glottis."""
-    names = list(tracts.af.region_names)
-    if "velum" not in names:
-        raise ArticError("the vocal tract has no 'velum' region in its area law; name one 'velum' in the config")
-    first = int(np.argmax(tracts.af.region == names.index("velum")))
-    return tracts.af.length_cm[:, :first].sum(axis=1)
-
-
 def tract_acoustics(tracts_path: Path | str, config: Path | str | None = None, frame: int | None = None,
                     lossless: bool = False, velum_area_cm2: float | None = None, out: Path | str | None = None,
                     progress=None) -> Acoustics:
     """The acoustics of every frame of a vocal-tract file (``frame``: one of them); the velopharyngeal port
     of each frame is the file's unless ``velum_area_cm2`` overrides it."""
     from . import vocal_tract as vt_stage
+    from ..tract.areas import port_positions
 
     check_number("--velum-area", velum_area_cm2, ge=0, le=10, unit="cm^2")
     cfg = load_config(config)

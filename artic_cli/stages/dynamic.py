@@ -12,6 +12,7 @@ from ..control.epmap import EPMaps
 from ..errors import ArticError
 from ..io.store import atomic_h5, content_hash_of, open_artifact
 from . import epmap as epmap_stage
+from . import paths
 from .base import Stage, up_to_date
 
 STAGE = Stage(name="dynamic", module=__name__, sections=(), reads=("epmaps",), kind="dynamic-map",
@@ -67,7 +68,7 @@ def fresh_recipe(maps: Path | str, out: Path | str) -> bool:
     return up_to_date(out, _provenance(maps))
 
 
-def build_dynamic_map(maps: Path | str = "data/epmaps.h5", out: Path | str = "data/dynamic.h5") -> DynamicMap:
+def build_dynamic_map(maps: Path | str = paths.EPMAPS, out: Path | str = paths.DYNAMIC) -> DynamicMap:
     """Fit the dynamic map to an EP-map file; ``out`` is left alone when it already holds this recipe."""
     prov = _provenance(maps)
     if up_to_date(out, prov):

@@ -28,6 +28,7 @@ from ..mechanics.model import ARTICULATOR_SECTIONS
 from ..parallel import Sweep, run_sweep
 from ..validation import check_number
 from . import mesh as mesh_stage
+from . import paths
 from .base import Stage, up_to_date
 
 STAGE = Stage(name="epmaps", module=__name__, sections=(*ARTICULATOR_SECTIONS, "epmap"), reads=("mesh",),
@@ -86,8 +87,8 @@ def _call(what: str, key: str, jaw_forces, forces, spec_json: str, fast: bool, c
     return compute_ep(key, jaw_forces, forces, spec_json, fast, cfg_json, mesh, wall)
 
 
-def build_ep_maps(mesh: Path | str = "data/mesh.h5", config: Path | str | None = None,
-                  out: Path | str = "data/epmaps.h5", jobs: int = 1, backend: str = "loky",
+def build_ep_maps(mesh: Path | str = paths.MESH, config: Path | str | None = None,
+                  out: Path | str = paths.EPMAPS, jobs: int = 1, backend: str = "loky",
                   scheduler: str | None = None, fast: bool = False, cache: Path | str | None = None,
                   progress: Callable[[int, int], None] | None = None, force: bool = False) -> BuildResult:
     """Compute (or bring up to date) every EP map of the config's ``epmap`` spec; write ``out`` (HDF5)."""
@@ -155,7 +156,7 @@ def write(path: Path | str, maps: EPMaps, cfg: Config, prov=None, fast: bool = F
                         f"cm moved over the last {cfg.epmap.convergence_window_ms:g} ms")
 
 
-def read(path: Path | str = "data/epmaps.h5", mesh: Path | str | None = None, shapes: bool = True) -> EPMaps:
+def read(path: Path | str = paths.EPMAPS, mesh: Path | str | None = None, shapes: bool = True) -> EPMaps:
     """Maps written by :func:`build_ep_maps` (``attrs`` holds the root attributes, ``content_sha256`` among
     them); with ``mesh``, checks they were built from that mesh's content.  ``shapes=False`` leaves the EPs'
     whole shapes out (the control points are what a spatial target is solved on; the shapes are most of the

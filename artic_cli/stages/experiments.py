@@ -16,6 +16,7 @@ from ..experiments.paper import EXPERIMENTS, HELD_JAW_EXPERIMENTS, Row, rows_as_
 from ..io.store import read_doc, write_doc
 from ..mechanics.model import ARTICULATOR_SECTIONS, Model
 from . import mesh as mesh_stage
+from . import paths
 from .base import Stage, up_to_date
 from .simulate import build
 
@@ -63,7 +64,7 @@ def figure_paths(doc: dict) -> dict:
     return {m: {"forces": d["forces_n"], "paths": np.asarray(d["paths_cm"])} for m, d in doc["figure"].items()}
 
 
-def run_experiment(name: str, mesh: Path | str = "data/mesh.h5", config: Path | str | None = None,
+def run_experiment(name: str, mesh: Path | str = paths.MESH, config: Path | str | None = None,
                    out: Path | str | None = None) -> dict:
     """Run one experiment on a mesh file and a config; with ``out``, write its table (left alone when it
     holds this recipe).  Returns the table as :func:`read` gives it."""

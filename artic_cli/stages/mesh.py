@@ -9,6 +9,7 @@ from ..config import Config, load_config
 from ..geometry.mesh import Mesh, tongue_mesh
 from ..geometry.wall import WallSurface, wall_surface
 from ..io.store import MESH_HINT, MeshFile, load_mesh, save_mesh
+from . import paths
 from .base import Stage, up_to_date
 
 STAGE = Stage(name="mesh", module=__name__, sections=("speaker",), kind="mesh", hint=MESH_HINT)
@@ -47,7 +48,7 @@ class MeshSummary:
     up_to_date: bool
 
 
-def build_mesh(config: Path | str | None = None, out: Path | str = "data/mesh.h5") -> MeshSummary:
+def build_mesh(config: Path | str | None = None, out: Path | str = paths.MESH) -> MeshSummary:
     """Build the mesh of a config's speaker into ``out``; a file holding the same recipe is left alone."""
     cfg = load_config(config)
     fresh = up_to_date(out, STAGE.provenance(cfg))

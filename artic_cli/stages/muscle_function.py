@@ -15,16 +15,17 @@ import numpy as np
 
 from ..config import Config, load_config
 from ..control.epmap import canonical, drivable_names
-from ..errors import ArticError
-from ..geometry.anatomy import check_muscle_names
-from ..experiments.muscle_function import MuscleFunction, model_and_rest, run_start, starts
 from ..control.equilibrium import watch_nodes
+from ..errors import ArticError
+from ..experiments.muscle_function import MuscleFunction, model_and_rest, run_start, starts
+from ..geometry.anatomy import check_muscle_names
 from ..io.fingerprint import code_hash, digest, sections_hash
 from ..io.store import atomic_h5, open_artifact
 from ..mechanics.model import ARTICULATOR_SECTIONS
 from ..parallel import Sweep, run_sweep
 from ..validation import check_number
 from . import mesh as mesh_stage
+from . import paths
 from .base import Stage, up_to_date
 
 STAGE = Stage(name="musclefunction", module=__name__, sections=(*ARTICULATOR_SECTIONS, "muscle_function"),
@@ -94,8 +95,8 @@ def read(path: Path | str) -> MuscleFunction:
             raise ArticError(f"{path} is damaged or incomplete ({type(err).__name__}); {hint}") from None
 
 
-def build_muscle_function(mesh: Path | str = "data/mesh.h5", config: Path | str | None = None,
-                          out: Path | str = "data/muscle_function.h5", jobs: int = 2, cache: Path | str | None = None,
+def build_muscle_function(mesh: Path | str = paths.MESH, config: Path | str | None = None,
+                          out: Path | str = paths.MUSCLE_FUNCTION, jobs: int = 2, cache: Path | str | None = None,
                           progress: Callable[[int, int], None] | None = None
                           ) -> tuple[MuscleFunction, float, int, int, bool]:
     """Run (or bring up to date) the study into ``out``: the study, wall time (s), distinct starts from the

@@ -18,12 +18,13 @@ from ..errors import ArticError
 from ..geometry.wall import WallSurface
 from ..io.fingerprint import digest
 from ..io.store import Provenance, atomic_h5, open_artifact
-from ..validation import check_number
 from ..mechanics.loads import load_program
 from ..mechanics.model import ARTICULATOR_SECTIONS, Model, build_articulator, build_model, rest_state
-from ..mechanics.simulate import Trajectory, run, settle
+from ..mechanics.simulate import Trajectory, problems, run, settle
 from ..schedule import Schedule, load_schedule
+from ..validation import check_number
 from . import mesh as mesh_stage
+from . import paths
 from .base import Stage, up_to_date
 
 STAGE = Stage(name="sims", module=__name__, sections=ARTICULATOR_SECTIONS, reads=("mesh",), kind="simulation",
@@ -61,26 +62,6 @@ def run_simulation(model: Model, schedule: Schedule, duration_s: float, dt_s: fl
 
 MIN_DT_S = 1e-6  # a step below a microsecond is a typo, not a simulation
 MAX_DURATION_S = 60.0
-VOLUME_LIMIT = 0.01  # a run with the volume constraint on that changes the tongue's volume more than this is not physical
-
-
-def problems(traj: Trajectory, volume_constraint: bool) -> list[str]:
-    """Why a trajectory is not physical (empty when it is): NaN, inverted bricks, a failed step, or (with the
-    volume constraint on) a volume change above 1 %."""
-    out = []
-    if traj.stats.get("failure"):
-        out.append(traj.stats["failure"])
-    if not np.isfinite(traj.x).all():
-        out.append("positions are not finite (NaN)")
-    if int(traj.inverted.max()) > 0:
-        k = int(np.argmax(traj.inverted > 0))
-        out.append(f"{int(traj.inverted.max())} inverted bricks (first at {traj.time[k] * 1e3:.0f} ms)")
-    vol = float(np.nanmax(np.abs(traj.volume_change)))
-    if volume_constraint and not vol <= VOLUME_LIMIT:
-        out.append(f"tongue volume changed by {100 * vol:.2f} % (limit {100 * VOLUME_LIMIT:g} %)")
-    return out
-
-
 @dataclass
 class SimResult:
     path: Path
@@ -93,7 +74,7 @@ class SimResult:
 
 
 def simulate(schedule: Path | str, duration: float | None = None, dt: float | None = None,
-             mesh: Path | str = "data/mesh.h5", config: Path | str | None = None, out: Path | str | None = None,
+             mesh: Path | str = paths.MESH, config: Path | str | None = None, out: Path | str | None = None,
              volume_constraint: bool | None = None, progress: Callable[[int, int], None] | None = None,
              tongue_only: bool = False, contact: bool | None = None, force: bool = False) -> SimResult:
     """Run the model under a schedule from its rest posture; write ``out`` (HDF5).  A file that already holds
@@ -112,7 +93,7 @@ def simulate(schedule: Path | str, duration: float | None = None, dt: float | No
     h = model.options.dt if dt is None else dt
     if h > duration:
         raise ArticError(f"--dt {h:g} s is longer than the run ({duration:g} s); give a smaller --dt")
-    out = Path(out) if out is not None else Path("data/sims") / f"{Path(schedule).stem}.h5"
+    out = Path(out) if out is not None else paths.SIMS / f"{Path(schedule).stem}.h5"
     sections = TONGUE_SECTIONS if tongue_only else ARTICULATOR_SECTIONS
     prov = STAGE.provenance(cfg, sections=sections,
                             inputs={"mesh": m.content_sha256, "schedule": digest(sched.mechanics_digest_data())},

@@ -2,19 +2,27 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 from ..config import load_config
+from ..control.acoustic_map import EPFormants
 from ..control.solver import TargetSpec
-from ..control.targets import Context, load_target, solve
+from ..control.targets import Context, batch_csv, load_target, read_batch, solve
+from ..control.targets import solve_batch as solve_rows
 from ..control.verify import Simulator
+from ..control.voicing import Voicer
 from ..errors import ArticError, UnreachableTarget
 from ..io.fingerprint import digest
-from ..io.store import content_hash_of, read_doc, write_doc
+from ..io.store import content_hash_of, read_doc, stored_content_hash, write_doc, write_text_atomic
 from ..mechanics.model import ARTICULATOR_SECTIONS
+from ..speech.plan import Answer
+from ..validation import check_number
+from . import acoustic_map as am_stage
 from . import dynamic as dynamic_stage
 from . import epmap as epmap_stage
 from . import mesh as mesh_stage
+from . import paths
 from .base import Stage, up_to_date
 
 SPATIAL_SECTIONS = (*ARTICULATOR_SECTIONS, "epmap")
@@ -23,7 +31,7 @@ STAGE = Stage(name="solve", module=__name__, sections=(*SPATIAL_SECTIONS, "vocal
               kind="solution", hint="rerun 'artic solve-target TARGET.yaml'")
 
 
-def load_context(maps: Path | str = "data/epmaps.h5", dynamic: Path | str | None = "data/dynamic.h5",
+def load_context(maps: Path | str = paths.EPMAPS, dynamic: Path | str | None = paths.DYNAMIC,
                  mesh: Path | str | None = None) -> Context:
     """The maps (checked against ``mesh``'s content when given) and the dynamic map (checked against the
     maps) a target is solved on; the EPs' control points, not their whole shapes (``add_formants`` reads those
@@ -39,18 +47,10 @@ def load_context(maps: Path | str = "data/epmaps.h5", dynamic: Path | str | None
 
 def add_formants(ctx: Context, maps: Path | str, mesh: Path | str, config: Path | str | None = None,
                  acoustic_maps: Path | str | None = None) -> Context:
-    """Give the context the formants of every EP (for acoustic targets): the acoustic maps (checked fresh) for
-    the config's lips and port and for its mapped lip tubes (``vocal_tract.mapped_lips``, the config's port),
-    and for other lips or ports the same computed from the EPs' shapes, one jaw position at a time (0.4 s for
-    a jaw position's vectors, 4.5 s with its nets)."""
-    from . import acoustic_map as am_stage
-    from . import vocal_tract as vt_stage
-    from ..io.store import stored_content_hash
-
+    """Give the context the formants of every EP (for acoustic targets, :class:`EPFormants`): the acoustic
+    maps, checked fresh, and for other lips or ports the same computed from the EPs' shapes."""
     cfg = load_config(config)
     m = mesh_stage.read(mesh, cfg)
-    vt = vt_stage.speaker_tract(cfg)
-    defaults = (float(vt.lips.area_cm2), float(vt.lips.length_cm), float(vt.velum_port_cm2))
     stored = None
     if acoustic_maps is not None and Path(acoustic_maps).is_file():
         prov = am_stage.STAGE.provenance(cfg, inputs={"mesh": m.content_sha256,
@@ -60,56 +60,9 @@ def add_formants(ctx: Context, maps: Path | str, mesh: Path | str, config: Path 
                              "rerun 'artic acoustic-map' (or leave --acoustic-maps out)")
         stored = am_stage.read(acoustic_maps, formants_only=True)
         ctx.acoustic_sha256 = str(stored_content_hash(acoustic_maps))
-    cache: dict = {}
-    whole: list = []  # the maps with the EPs' shapes, read once when other lips or ports need them
-
-    def formants(jaw: str, area: float, length: float, port: float) -> dict:
-        key = (jaw, *am_stage.lip_key(area, length), round(port, 6))
-        if key not in cache:
-            mapped = stored is not None and key[3] == round(defaults[2], 6)  # the acoustic maps hold the config's port
-            held = stored.formants_with(jaw, area, length) if mapped else None  # one of its mapped lip tubes
-            if mapped and jaw in stored.jaws and key[1:3] == am_stage.lip_key(*defaults[:2]):
-                cache[key] = {k: n.formants_hz for k, n in stored.jaws[jaw].items()}
-            elif held is not None:
-                cache[key] = held
-            else:
-                if not whole:
-                    whole.append(epmap_stage.read(maps))
-                nets = am_stage.compute(cfg, m.mesh, whole[0], jaws=[jaw], overrides={
-                    "lip_area_cm2": area, "lip_length_cm": length, "velum_port_cm2": port}, bandwidths=False).jaws[jaw]
-                cache[key] = {k: n.formants_hz for k, n in nets.items()}
-        return cache[key]
-
-    ctx.formants, ctx.lips_default, ctx.port_default = formants, defaults[:2], defaults[2]
+    oracle = EPFormants(cfg, m.mesh, lambda: epmap_stage.read(maps), stored)
+    ctx.formants, ctx.lips_default, ctx.port_default = oracle, oracle.defaults[:2], oracle.defaults[2]
     return ctx
-
-
-class Voicer:
-    """A simulator that also gives the vocal tract and formants of the force set it holds."""
-
-    def __init__(self, sim: Simulator, cfg):
-        from . import vocal_tract as vt_stage
-
-        self.sim, self.cfg = sim, cfg
-        self.vt = vt_stage.speaker_tract(cfg)
-        self.mesh_sha256 = sim.mesh_sha256
-
-    def reach(self, jaw_forces: dict[str, float], forces: dict[str, float]):
-        return self.sim.reach(jaw_forces, forces)
-
-    def voice(self, jaw_forces: dict[str, float], forces: dict[str, float], lips: tuple[float, float],
-              port: float) -> dict:
-        from .acoustic_map import net_acoustics
-
-        x, cp = self.sim.shape(jaw_forces, forces)
-        rest, mandible = self.sim.model_rest()
-        n = net_acoustics(self.vt, self.cfg, self.sim.mesh, rest, mandible, x[None], {
-            "lip_area_cm2": lips[0], "lip_length_cm": lips[1], "velum_port_cm2": port})
-        r = lambda v: [round(float(a), 4) for a in v]  # noqa: E731
-        return {"formants_hz": [float(v) for v in n.formants_hz[0]],
-                "reached_cm": {"tip": r(cp[0, :2]), "dorsum": r(cp[1, :2])},
-                "area_function": {"length_cm": r(n.length_cm[0]), "area_cm2": r(n.area_cm2[0]),
-                                  "order": "glottis to lips, the lip tube last"}}
 
 
 def simulator(mesh: Path | str, config: Path | str | None = None, voiced: bool = False) -> Simulator | Voicer:
@@ -137,7 +90,7 @@ def solve_target(target: Path | str | TargetSpec, ctx: Context, out: Path | str 
     """Solve one target; write the answer (also when it is unreachable: then UnreachableTarget is raised
     after writing).  Returns the document, its path and whether it was already up to date."""
     t = load_target(target) if not isinstance(target, TargetSpec) else target
-    path = Path(out) if out is not None else Path("data/solutions") / f"{t.name}.yaml"
+    path = Path(out) if out is not None else paths.SOLUTIONS / f"{t.name}.yaml"
     cfg = load_config(config) if (verify or refine) else None
     inputs = {"epmaps": ctx.maps_sha256, "dynamic": ctx.dynamic_sha256, "target": digest(t.model_dump(mode="json"))}
     if verify or refine or t.acoustic is not None:
@@ -166,3 +119,100 @@ def solve_target(target: Path | str | TargetSpec, ctx: Context, out: Path | str 
         raise
     write(path, doc, prov)
     return read(path), path, False
+
+
+def solution_path(folder: Path | str, t: TargetSpec) -> Path:
+    """Where a batch keeps a target's answer: its name and the first digits of its content key."""
+    return Path(folder) / f"{t.name}-{digest(t.model_dump(mode='json'))[:8]}.yaml"
+
+
+def solve_batch(targets: list[TargetSpec], maps: Path | str, mesh: Path | str, acoustic_maps: Path | str | None,
+                config: Path | str | None, folder: Path | str, budget: int = 8, dynamic: Path | str | None = None,
+                jobs: int = 1) -> list[Answer]:
+    """Solve and refine every target (each answer kept under ``folder``, up-to-date ones read back), in this
+    process with the maps and simulators loaded once, or one target per process on ``jobs`` workers.  An
+    unreachable target is an :class:`Answer` carrying its error; any other error is raised (the earliest
+    target's)."""
+    args = (maps, mesh, acoustic_maps, config, str(folder), budget, None if dynamic is None else str(dynamic))
+    if jobs > 1 and len(targets) > 1:
+        from joblib import Parallel, delayed
+
+        answers = Parallel(n_jobs=min(jobs, len(targets)))(delayed(_solve_one)(t, *args) for t in targets)
+        failed = [a for a in answers if isinstance(a, ArticError)]
+        if failed:
+            raise failed[0]
+        return answers
+    return _solve_here(targets, *args)
+
+
+def _solve_one(t: TargetSpec, *args) -> Answer | ArticError:
+    """One target in a worker process; its error is returned (the parent raises the earliest target's)."""
+    try:
+        return _solve_here([t], *args)[0]
+    except ArticError as err:
+        return err
+
+
+def _solve_here(targets: list[TargetSpec], maps, mesh, acoustic_maps, config, folder: str, budget: int,
+                dynamic: str | None) -> list[Answer]:
+    if not targets:
+        return []
+    ctx = load_context(maps, dynamic, mesh)
+    sim = voicer = None
+    if any(t.acoustic is not None for t in targets):
+        add_formants(ctx, maps, mesh, config, acoustic_maps)
+        voicer = simulator(mesh, config, voiced=True)
+    if any(t.acoustic is None for t in targets):
+        sim = voicer.sim if voicer is not None else simulator(mesh, config)
+    mesh_sha = (voicer.sim if voicer is not None else sim).mesh_sha256
+    out = []
+    for t in targets:
+        path = solution_path(folder, t)
+        try:
+            doc, path, _ = solve_target(t, ctx, path, voicer if t.acoustic is not None else sim, False, True, budget,
+                                        config, mesh_sha)
+            out.append(Answer(doc, path))
+        except UnreachableTarget as err:
+            out.append(Answer(read(path) if path.is_file() else None, path, err))
+    return out
+
+
+@dataclass
+class Solved:
+    """What ``artic solve-target`` solved: one target's answer, or a batch's rows written as CSV."""
+
+    target: TargetSpec | None = None
+    doc: dict | None = None
+    path: Path | None = None
+    up_to_date: bool = False
+    rows: list[dict] | None = None  # a batch's answers
+
+
+def solve_files(target: Path | str | None = None, batch: Path | str | None = None, maps: Path | str = paths.EPMAPS,
+                dynamic: Path | str = paths.DYNAMIC, mesh: Path | str = paths.MESH, config: Path | str | None = None,
+                acoustic_maps: Path | str = paths.ACOUSTIC_MAPS, out: Path | str | None = None,
+                verify: bool = False, refine: bool = False, budget: int = 8, jobs: int = 2,
+                progress=None) -> Solved:
+    """A target file, or every row of a batch CSV (written to ``out``, default data/solutions/BATCH.csv, with
+    ``verify``/``refine`` on ``jobs`` workers), solved on the maps; what a target needs is loaded once: the
+    dynamic map for places, the formants of every EP for acoustic targets, the simulator for checks."""
+    if (target is None) == (batch is None):
+        raise ArticError("give a target file or --batch CSV (one of them)")
+    check_number("--budget", budget, ge=1)
+    check_number("--jobs", jobs, ge=1)
+    targets = read_batch(batch) if batch is not None else [load_target(target)]  # the user's file first
+    acoustic = any(t.acoustic is not None for t in targets)
+    spatial = any(t.acoustic is None for t in targets)  # acoustic targets use the mapped jaw positions only
+    ctx = load_context(maps, dynamic if spatial else None, mesh if (verify or refine or acoustic) else None)
+    if acoustic:
+        add_formants(ctx, maps, mesh, config, acoustic_maps)
+    sim = simulator(mesh, config, voiced=acoustic) if (verify or refine) else None
+    if batch is not None:
+        args = None if sim is None else (sim.cfg, sim.mesh, sim.wall, sim.mesh_sha256)
+        rows = solve_rows(ctx, targets, jobs, args, verify, refine, budget, progress)
+        path = Path(out) if out is not None else paths.SOLUTIONS / f"{Path(batch).stem}.csv"
+        write_text_atomic(path, batch_csv(rows))
+        return Solved(path=path, rows=rows)
+    doc, path, fresh = solve_target(targets[0], ctx, out, sim, verify, refine, budget, config,
+                                    "" if sim is None else sim.mesh_sha256)
+    return Solved(target=targets[0], doc=doc, path=path, up_to_date=fresh)

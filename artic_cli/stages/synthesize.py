@@ -3,22 +3,18 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated
 
 import numpy as np
 from pydantic import Field
-from scipy.io import wavfile
 
-from ..acoustics.model import tract_of
-from ..acoustics.resample import half_rate
-from ..acoustics.source import lf_flow_derivative
-from ..acoustics.synthesis import noise_samples, resample_tube, sections_for, side_branch, synthesize
 from ..acoustics.tube import Tube, read_tube_csv
+from ..acoustics.voice import Audio, synthesize_frames
+from ..acoustics.voice import synthesize_tube as voice_tube
 from ..config import Config, load_config
 from ..errors import ArticError
-from ..io.store import atomic_path
+from ..io.wav import write_wav
 from ..validation import F0Hz, NonNegative, Strict, check_number, read_csv
 from .base import Stage
 
@@ -27,109 +23,19 @@ STAGE = Stage(name="synthesize", module=__name__, sections=("acoustics",), kind=
 MAX_DURATION_S = 60.0
 
 
-@dataclass
-class Audio:
-    samples: np.ndarray  # float, peak 0.9 (-1 dBFS)
-    sample_rate_hz: int
-
-
-def f0_track(times_s: np.ndarray, f0: float | None, contour: list[tuple[float, float]] | None) -> np.ndarray:
-    if contour:
-        t, f = np.array(contour).T
-        return np.interp(times_s, t, f)
-    return np.full(len(times_s), float(f0))
-
-
-def frame_areas(lengths_cm: np.ndarray, areas_cm2: np.ndarray, n: int) -> np.ndarray:
-    """(F, n) areas at n equal sections of each frame's own length (frames x sections in)."""
-    return np.stack([resample_tube(lengths_cm[k], areas_cm2[k], n) for k in range(len(areas_cm2))])
-
-
-def source_for(t_s: np.ndarray, fs: float, sy, f0_hz: float | None, contour, amplitude=None,
-               aspiration: float = 0.0, seed: int = 0) -> np.ndarray:
-    """The glottal flow derivative with 20-ms fades at both ends, an amplitude contour ((time_s, gain)
-    points) and aspiration: white noise of ``aspiration`` times the voice's RMS, gated by the glottis's
-    opening phase (noise while air flows)."""
-    src = lf_flow_derivative(f0_track(t_s, f0_hz, contour), fs, sy.lf_tp, sy.lf_te, sy.lf_ta)
-    if aspiration > 0:
-        rms = float(np.sqrt(np.mean(src ** 2))) if len(src) else 0.0
-        gate = (src != 0).astype(float) * 0.5 + 0.5 * (np.abs(src) > 0.05)
-        src = src + aspiration * rms * gate * np.random.default_rng(seed).standard_normal(len(src))
-    gain = np.ones(len(t_s))
-    if amplitude:
-        ta, ga = np.array(amplitude).T
-        gain = np.interp(t_s, ta, ga)
-    fade = np.minimum(1.0, np.minimum(t_s, t_s[-1] - t_s) / 0.02) if len(t_s) else t_s
-    return src * gain * fade
-
-
 def compute(tube: Tube, cfg: Config, duration_s: float, f0_hz: float | None = 110.0,
             contour: list[tuple[float, float]] | None = None, amplitude=None, aspiration: float = 0.0) -> Audio:
-    """A tube held for ``duration_s``."""
-    return compute_frames(tube.length_cm[None], tube.area_cm2[None], np.array([0.0]), cfg, duration_s, f0_hz,
-                          contour, amplitude, aspiration)
+    """A tube held for ``duration_s`` (:func:`artic_cli.acoustics.voice.synthesize_tube`)."""
+    return voice_tube(tube, STAGE.view(cfg).acoustics, duration_s, f0_hz, contour, amplitude, aspiration)
 
 
 def compute_frames(lengths_cm: np.ndarray, areas_cm2: np.ndarray, times_s: np.ndarray, cfg: Config,
-                   duration_s: float, f0_hz: float | None = 110.0, contour=None, amplitude=None,
-                   aspiration: float = 0.0, flow_peak_cm3_s: float | None = None, noise=None) -> Audio:
-    """Area functions (frames x sections, glottis first) at ``times_s``, interpolated at the line's rate; the
-    line's sections are cut from the frames' mean length (each frame resampled over its own length).
-    ``noise``: (RMS dyn/cm^2 (F,), place as a fraction of the length from the glottis (F,), seed), a turbulence
-    source per frame, with the
-    voice's flow peak ``flow_peak_cm3_s`` setting their relative level."""
-    ac = STAGE.view(cfg).acoustics
-    sy = ac.synthesis
-    fs = 2 * sy.sample_rate_hz  # the line runs at twice the audio rate
-    n = sections_for(float(np.mean(lengths_cm.sum(axis=1))), ac.sound_speed_cm_s, fs)
-    areas = frame_areas(lengths_cm, areas_cm2, n)
-    t = np.arange(int(round(duration_s * fs))) / fs
-    src = source_for(t, fs, sy, f0_hz, contour, amplitude, aspiration)
-    branch = None
-    pf = ac.piriform_fossa
-    mean_length = float(np.mean(lengths_cm.sum(axis=1)))
-    if pf.enabled and mean_length > pf.from_glottis_cm:  # the transfer function's fossa (acoustics/model.py)
-        fossa = tract_of(Tube(np.array([mean_length]), np.array([1.0])), ac, velum_area_cm2=0.0).branches[0].tube
-        branch = side_branch(pf.from_glottis_cm, mean_length, n, fossa.length_cm, fossa.area_cm2,
-                             ac.sound_speed_cm_s, fs)
-    pn = None
-    if noise is not None:
-        rms, at_fraction, seed = noise
-        pn = noise_samples(np.asarray(times_s, float), rms, at_fraction, t, n, seed)
-    y = synthesize(areas, np.asarray(times_s, float) - float(times_s[0]), src, fs, sy.glottal_reflection,
-                   sy.section_loss, ac.air_density_g_cm3, ac.sound_speed_cm_s, branch, flow_peak_cm3_s, pn,
-                   (ac.wall_mass_g_cm2, ac.wall_resistance_dyn_s_cm3, ac.wall_stiffness_dyn_cm3)
-                   if ac.yielding_walls else None)
-    y = half_rate(y)
-    peak = float(np.max(np.abs(y))) if len(y) else 0.0
-    return Audio(0.9 * y / peak if peak > 0 else y, sy.sample_rate_hz)
+                   duration_s: float, *args, **options) -> Audio:
+    """Area functions in time (:func:`artic_cli.acoustics.voice.synthesize_frames`)."""
+    return synthesize_frames(lengths_cm, areas_cm2, times_s, STAGE.view(cfg).acoustics, duration_s, *args, **options)
 
 
-def write(path: Path | str, audio: Audio) -> Path:
-    """16-bit PCM WAV, written through a temporary file and a rename."""
-    path = Path(path)
-    pcm = np.round(np.clip(audio.samples, -1, 1) * 32767).astype(np.int16)
-    with atomic_path(path, ".wav") as tmp:
-        wavfile.write(tmp, audio.sample_rate_hz, pcm)
-    return path
-
-
-def read_wav(path: Path | str) -> tuple[np.ndarray, int]:
-    """Samples (float, -1..1, the first channel) and the rate of a WAV file; a missing or damaged file is
-    one error naming the fix."""
-    path = Path(path)
-    if not path.is_file():
-        raise ArticError(f"WAV file not found: {path}; give an existing file (rerun 'artic synthesize')")
-    try:
-        rate, data = wavfile.read(path)
-    except (ValueError, OSError, EOFError):
-        raise ArticError(f"{path} is not a readable WAV file (corrupted or truncated); rerun 'artic synthesize'") from None
-    data = np.asarray(data)
-    if data.ndim > 1:
-        data = data[:, 0]
-    scale = float(np.iinfo(data.dtype).max) if np.issubdtype(data.dtype, np.integer) else 1.0
-    return data.astype(float) / scale, int(rate)
-
+write = write_wav
 
 class F0Point(Strict):
     time_s: NonNegative

@@ -53,7 +53,7 @@ def test_formants_without_bandwidths_are_the_same_frequencies():
     from artic_cli.acoustics.transfer import transfer
     from artic_cli.acoustics.tube import Tube
     from artic_cli.config import load_config
-    from artic_cli.stages.acoustics import tract_of
+    from artic_cli.acoustics.model import tract_of
 
     ac = load_config().acoustics
     rng = np.random.default_rng(7)

@@ -221,7 +221,7 @@ def test_export_writes_paraview_files_and_ema_csv(mesh_file, tmp_path):
 def test_a_ctrl_c_inside_compiled_code_counts_as_an_interrupt():
     """numba turns a KeyboardInterrupt that lands during a callback into SystemError (cause: the interrupt);
     the CLI must still exit with 130 and its one line, and must not swallow genuine SystemErrors."""
-    from artic_cli.cli.main import interrupted
+    from artic_cli.cli.app import interrupted
 
     def raised(inner):
         try:

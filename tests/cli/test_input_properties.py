@@ -222,7 +222,7 @@ def test_any_utterance_is_read_or_refused_in_one_line(utterance):
     """Every utterance either reads as a valid one (durations positive, F0 50-500 Hz with rising times, one
     source per segment) or is one ArticError naming its key; speaking the valid ones is tested elsewhere."""
     from artic_cli.errors import ArticError
-    from artic_cli.utterance import parse_utterance
+    from artic_cli.speech.utterance import parse_utterance
 
     try:
         u = parse_utterance(utterance, "u.yaml")

@@ -100,7 +100,7 @@ def test_the_open_jaw_reaches_one_equilibrium_whether_its_forces_step_or_open_wi
     solver's hold) or opened with a 40-ms pulse of twice the forces (the utterances' pulse_step): one EP, the
     dorsum's two ends within 0.05 cm.  With the straps pulling only (jaw.strap_slack_strain 0.006) the step
     sinks the hyoid 0.8 cm onto the straps' flat push and the pulse does not: the two ends lie 0.31 cm apart."""
-    from artic_cli.control.course import activated, course
+    from artic_cli.speech.course import activated, course
     from artic_cli.mechanics.loads import control_from_newtons
     from artic_cli.mechanics.simulate import run, settle
 

@@ -6,7 +6,7 @@ import pytest
 from artic_cli.errors import ArticError
 from artic_cli.experiments.paper import (BLADE_FORCES, PAPER_DIRECTIONS, TIP_FORCES, fig4, jaw_ep, k_closure,
                                         muscle_directions, stress)
-from artic_cli.mechanics.contact import wall_query
+from artic_cli.mechanics.wall_query import wall_query
 from artic_cli.mechanics.loads import muscle_force_vector
 from artic_cli.mechanics.model import Control, build_articulator
 from artic_cli.mechanics.muscles import FL_RANGE, force_length, force_length_slope

@@ -9,11 +9,11 @@ from artic_cli.mechanics.integrator import internal_forces
 
 def test_compiled_kernels_give_the_numpy_numbers(art):
     """The numba loops (cylinders, bricks, guard, fibres) reproduce the numpy path, including a guarded corner."""
-    from artic_cli.mechanics import kernels
+    from artic_cli import jit
     from artic_cli.mechanics.integrator import tangent
     from artic_cli.mechanics.muscles import fibre_state, length_gradients, muscle_forces
 
-    if not kernels.AVAILABLE:
+    if not jit.AVAILABLE:
         pytest.skip("numba not installed: only the numpy path runs")
     rng = np.random.default_rng(3)
     x = art.rest + rng.normal(0, 0.05, art.rest.shape)
@@ -25,7 +25,7 @@ def test_compiled_kernels_give_the_numpy_numbers(art):
     ms = art.muscles
     out = {}
     for flag in (False, True):
-        elements.USE_KERNELS = flag
+        jit.USE_KERNELS = flag
         try:
             f, cs, vol, grad, guard = internal_forces(art, x, v, frame)
             fs = fibre_state(ms, x, act, np.full(ms.n_fibres, 50.0), np.full(ms.n_fibres, -0.01), 0.005)
@@ -34,7 +34,7 @@ def test_compiled_kernels_give_the_numpy_numbers(art):
             lg = length_gradients(ms, fs, fibres, art.n_nodes)
             fm = muscle_forces(ms, fs)
         finally:
-            elements.USE_KERNELS = True
+            jit.USE_KERNELS = True
         out[flag] = (f, vol, grad, guard, k.band, k.b, k.c, lg, fm, fs.seg_length, fs.strain, fs.sigma2, fs.tension)
     assert out[True][3] is not None and len(out[True][3][0]) == len(out[False][3][0]) > 0
     for a, c in zip(out[False], out[True]):

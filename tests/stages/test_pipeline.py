@@ -132,7 +132,7 @@ def test_the_tracts_of_the_pipeline_and_of_one_ep(built, tmp_path):
         with h5py.File(built / "sims" / f"{name}.h5", "r") as f:
             assert t.n_frames == f["time"].shape[0]
     from artic_cli.stages.acoustics import read as read_acoustics
-    from artic_cli.stages.synthesize import read_wav
+    from artic_cli.io.wav import read_wav
 
     for name in ("rest", "art_sg_jo"):
         ac = read_acoustics(built / "acoustics" / f"{name}.h5")

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from artic_cli.stages.report import PAPER_RUN_ENV, paper_run, run_section
+from artic_cli.report.run import PAPER_RUN_ENV, paper_run, run_section
 
 
 @pytest.mark.parametrize("value", [None, "", "1 1", "x 1 2", "1 1 0", "nan 1 2", "1 1 2 3"])

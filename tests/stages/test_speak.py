@@ -10,9 +10,11 @@ import yaml
 
 from artic_cli.acoustics.aerodynamics import flow, noise_rms, reynolds
 from artic_cli.acoustics.measures import band_level_db
-from artic_cli.control.course import course
+from artic_cli.io.wav import read_wav
+from artic_cli.speech.course import course
+from artic_cli.speech.measures import measures
+from artic_cli.speech.plan import Plan
 from artic_cli.stages import speak
-from artic_cli.stages.synthesize import read_wav
 
 from conftest import ROOT, run_cli
 
@@ -127,7 +129,7 @@ def test_a_spoken_sequence_writes_its_sound_textgrid_and_record(spoken, mesh_fil
 def test_a_closure_is_silent_and_its_release_makes_a_burst(spoken):
     rec = speak.read(spoken / "lab.h5")
     y, rate = read_wav(spoken / "lab.wav")
-    m = speak.measures(rec, y, rate)
+    m = measures(rec, y, rate)
     (c, *_) = m["closures"]
     assert 60 <= c["duration_ms"] <= 110 and c["start_s"] == pytest.approx(0.21, abs=0.01)
     vowel_db = np.mean([s["level_db"] for s in m["segments"] if s["label"] == "a"])
@@ -148,7 +150,7 @@ def _vcv(tmp_path, mesh_file, name: str, f0_end_s: float, vowel: dict, first_ms:
     assert res.exit_code == 0, res.output
     rec = speak.read(tmp_path / f"{name}.h5")
     y, rate = read_wav(tmp_path / f"{name}.wav")
-    return rec, y, rate, speak.measures(rec, y, rate)
+    return rec, y, rate, measures(rec, y, rate)
 
 
 def _one_stop_closure(m: dict, earliest_s: float, latest_s: float) -> dict:
@@ -191,10 +193,10 @@ def test_a_laminal_stop_seals_the_blade_on_the_ridge_silently(tmp_path, mesh_fil
     assert where[0] > 2.0, where  # the lips 1 cm, the incisors' section 0.15 cm: the blade closes on the ridge
     # the closure is the tongue's, not the teeth's: while closed, the lower incisor edge stays >= 0.1 cm from the
     # upper incisor (JC 3 N puts it on the upper one and the tract then closes between them)
-    from artic_cli.control.solver import _polyline_nearest
+    from artic_cli.control.solver import polyline_nearest
 
     upper = np.array(yaml.safe_load((ROOT / "configs" / "default.yaml").read_text())["vocal_tract"]["upper_incisor_cm"])
-    assert min(_polyline_nearest(upper, p)[0] for p in rec.control_points["jaw"][closed][:, :2]) >= 0.1
+    assert min(polyline_nearest(upper, p)[0] for p in rec.control_points["jaw"][closed][:, :2]) >= 0.1
     assert m["peak_speed_cm_s"]["tip"] <= 60.0 and m["peak_speed_cm_s"]["jaw"] <= 18.0
     assert rec.attrs["max_beyond_wall_cm"] <= 0.01 and np.nanmax(np.abs(rec.volume_change)) <= 0.003
 
@@ -217,7 +219,7 @@ def test_an_alveolar_channel_makes_s_frication_20_db_above_the_vowels(tmp_path, 
 def test_a_narrow_channel_makes_frication_that_the_noise_switch_removes(spoken, mesh_file, tmp_path):
     rec = speak.read(spoken / "lab.h5")
     y, rate = read_wav(spoken / "lab.wav")
-    seg = {s["label"]: s for s in speak.measures(rec, y, rate)["segments"]}
+    seg = {s["label"]: s for s in measures(rec, y, rate)["segments"]}
     fric = band_level_db(y, rate, 0.49, 0.58, 3000.0)
     d = yaml.safe_load((ROOT / "configs" / "default.yaml").read_text())
     d["speech"] = {"noise": {"enabled": False}}
@@ -231,7 +233,7 @@ def test_a_narrow_channel_makes_frication_that_the_noise_switch_removes(spoken, 
 
 
 def test_activation_dynamics_lag_the_course_by_their_time_constants():
-    from artic_cli.control.course import activated
+    from artic_cli.speech.course import activated
 
     step = course([0.0, 0.2], np.array([[2.0], [0.0]]), 0.0)  # a force step on at 0 and off at 200 ms
     g = activated(step, 0.4, 0.015, 0.04)
@@ -245,7 +247,7 @@ def test_activation_dynamics_lag_the_course_by_their_time_constants():
 
 
 def test_a_pulse_step_course_opens_each_segment_with_a_clipped_pulse():
-    from artic_cli.control.course import pulse_step
+    from artic_cli.speech.course import pulse_step
 
     starts, sets = pulse_step([0.0, 0.2], [0.2, 0.05], np.array([[4.0, 0.0], [1.0, 3.0]]), 0.04, 1.0, 6.0)
     assert starts.tolist() == pytest.approx([0.0, 0.04, 0.2, 0.225])  # the second pulse: half its 50-ms segment
@@ -253,7 +255,7 @@ def test_a_pulse_step_course_opens_each_segment_with_a_clipped_pulse():
 
 
 def test_a_jaw_pulse_below_zero_drives_the_closers():
-    from artic_cli.control.course import pulse_step
+    from artic_cli.speech.course import pulse_step
 
     jo, jc = np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.5, 0.5])  # unit shares: an opener, two closers
     starts, sets = pulse_step([0.0, 0.2], [0.2, 0.2], np.array([[4.0, 0.0, 0.0], [0.0, 0.0, 0.0]]), 0.04, 1.5, 6.0,
@@ -346,12 +348,12 @@ def test_a_segment_s_own_lead_moves_its_forces_alone_and_press_scales_only_the_t
     assert _commanded_at(rec, 0.14)[ggp].sum() > 1.9  # ... not at its sound (0.15 s)
     # press: a solved target's tongue forces times the factor, the jaw's kept (the plan given, nothing solved)
     from artic_cli.stages import mesh as mesh_stage
-    from artic_cli.utterance import parse_utterance
+    from artic_cli.speech.utterance import parse_utterance
 
     target = {"name": "k", "jaw": {"forces_n": {"JO": 1.0}}, "crucial": {"point": "dorsum", "at_cm": [-4.4, 1.6]}}
     u = parse_utterance({"segments": [{"target": target, "duration_ms": 60, "press": 1.5}], "force_course": "static",
                          "lead_ms": 0, "prepare_ms": 0, "ramp_ms": 0})
-    plan = speak.Plan(labels=["k"], starts_s=np.array([0.0]), durations_s=np.array([0.06]),
+    plan = Plan(labels=["k"], starts_s=np.array([0.0]), durations_s=np.array([0.06]),
                       forces_n=[{"JO": 1.0, "SG": 2.0}], lips=[(3.0, 1.0)], ports=[0.0], voiced=np.array([False]),
                       notes=["solved"], solutions=[""])
     m = mesh_stage.read(mesh_file, cfg)

@@ -7,9 +7,13 @@ import pytest
 import yaml
 
 from artic_cli.acoustics.tube import read_tube_csv
+from artic_cli.control.equilibrium import parse_ep
 from artic_cli.errors import ArticError
 from artic_cli.stages import vocal_tract as vts
 from artic_cli.stages.simulate import simulate
+from artic_cli.tract.areas import tracts_of
+from artic_cli.tract.controls import controls_for
+from artic_cli.tract.shapes import shapes_of_simulation
 
 from conftest import ROOT
 
@@ -110,7 +114,7 @@ def test_bad_input_is_one_error_and_no_file(work, mesh_file, other_mesh_file, do
     with pytest.raises(ArticError, match="--velum-port"):
         vts.vocal_tract(rest=True, mesh=mesh_file, config=CONFIG, out=work / "bad.h5", velum_port=float("nan"))
     with pytest.raises(ArticError, match="JAW:MUSCLE=N"):
-        vts.parse_ep("SG=2")
+        parse_ep("SG=2")
     with pytest.raises(ArticError, match="exactly one"):
         vts.vocal_tract(mesh=mesh_file, config=CONFIG, out=work / "bad.h5")
     assert not (work / "bad.h5").exists()
@@ -144,10 +148,10 @@ def test_a_simulation_of_another_config_or_an_untraceable_shape_is_refused(work,
     from artic_cli.stages.simulate import read
     from artic_cli.stages.mesh import read as read_mesh
 
-    shapes = vts.shapes_of_simulation(read(dorsum_sim), read_mesh(mesh_file).mesh)
+    shapes = shapes_of_simulation(read(dorsum_sim), read_mesh(mesh_file).mesh)
     shapes.tongue_cm[-1] -= np.array([0.0, 6.0])  # the last frame's tongue dropped out of the grid's reach
     with pytest.raises(ArticError, match="midline cannot be traced"):
-        vts.compute(cfg.vocal_tract, cfg.speaker.wall, shapes, vts.controls_for(cfg.vocal_tract, shapes.time_s))
+        tracts_of(cfg.vocal_tract, cfg.speaker.wall, shapes, controls_for(cfg.vocal_tract, shapes.time_s))
     assert not (work / "bad2.h5").exists()
 
 

@@ -31,10 +31,10 @@ from typing import Annotated, Literal
 
 from pydantic import Field, field_validator, model_validator
 
-from .config import read_yaml
-from .errors import ArticError
-from .schedule import TractEntry
-from .validation import DurationMs, ForceN, SafeName, Strict, increasing, parse
+from ..config import read_yaml
+from ..errors import ArticError
+from ..schedule import TractEntry
+from ..validation import DurationMs, ForceN, SafeName, Strict, increasing, parse
 
 MAX_UTTERANCE_MS = 20000.0
 

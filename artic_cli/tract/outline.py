@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..config import VocalTract, WallGeometry
-from .mesh import resample_polyline
+from ..geometry.mesh import resample_polyline
 
 
 @dataclass(frozen=True)

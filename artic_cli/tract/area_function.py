@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..geometry.tract import Grid
+from .outline import Grid
 
 _EPS = 1e-12
 

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from artic_cli.acoustics.area_function import area_functions, segments, touched_lines
+from artic_cli.tract.area_function import area_functions, segments, touched_lines
 from artic_cli.config import AreaRegion
-from artic_cli.geometry.tract import tract_grid
+from artic_cli.tract.outline import tract_grid
 from artic_cli.schedule import TractEntry, tract_controls
 
 
@@ -71,7 +71,7 @@ def test_tract_controls_follow_a_smooth_ramp():
 
 
 def test_the_band_area_of_a_uniform_slab_is_its_width_times_its_depth(cfg):
-    from artic_cli.acoustics.area_function import band_areas
+    from artic_cli.tract.area_function import band_areas
 
     vt = _channel_tract(cfg, [AreaRegion(name="all", until_cm=99.0, alpha=1.7, beta=1.3)])
     inner = [np.array([[-1.0, -0.3], [8.0, -0.3]])]

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from artic_cli.acoustics.area_function import point_segment_distance
-from artic_cli.geometry.tract import larynx_front, outer_contour
+from artic_cli.tract.area_function import point_segment_distance
+from artic_cli.tract.outline import larynx_front, outer_contour
 
 WALL = np.array([[-7.8, 0.0], [-7.6, -5.0], [-7.2, -8.0], [-7.15, -8.3]])  # posterior wall, top to bottom
 

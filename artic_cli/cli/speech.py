@@ -1,0 +1,86 @@
+"""``artic`` commands: speech: utterances spoken from targets in time."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+from ..errors import ArticError
+from ..stages import paths
+from ..validation import check_number
+from .app import app, err_console, handle_errors, out_console, with_progress
+
+
+@app.command("speak")
+@handle_errors
+def speak_cmd(
+    utterance: Path = typer.Argument(..., help="Utterance file (YAML): segments (a target or forces, a duration), "
+                                               "an F0 contour, a lip and velum course."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Sound to write (WAV); the TextGrid and NAME.h5 go "
+                                                           "beside it (default data/utterances/NAME.wav)."),
+    maps: Path = typer.Option(paths.EPMAPS, "--maps", help="EP maps the targets are solved on."),
+    dynamic: Path = typer.Option(paths.DYNAMIC, "--dynamic", help="Dynamic map, read only for a place "
+                                 "target at a jaw position the maps hold no nets for."),
+    acoustic_maps: Path = typer.Option(paths.ACOUSTIC_MAPS, "--acoustic-maps",
+                                       help="Formants of every EP (vowel targets)."),
+    mesh: Path = typer.Option(paths.MESH, "--mesh", help="Mesh from 'artic build-mesh'."),
+    config: Optional[Path] = typer.Option(None, "--config", help="Config (its 'speech' section: ramps, glottis, "
+                                                                 "lungs, noise)."),
+    solutions: Optional[Path] = typer.Option(None, "--solutions", help="Where the targets' solutions are cached "
+                                                                       "(default: a 'solutions' folder beside --out)."),
+    accept_nearest: bool = typer.Option(False, "--accept-nearest", help="Speak the nearest reachable answer of an "
+                                                                        "unreachable target instead of stopping."),
+    budget: int = typer.Option(8, "--budget", help="Most simulations each target's refinement may spend."),
+    jobs: int = typer.Option(1, "--jobs", help="Processes solving distinct targets at once."),
+    plot: Optional[Path] = typer.Option(None, "--plot", help="Spectrogram with formant tracks, segments and the "
+                                                             "tip/dorsum/jaw heights (PNG)."),
+    animate: Optional[Path] = typer.Option(None, "--animate", help="The midsagittal view moving (GIF)."),
+):
+    """Speak a sequence of targets: each solved once, its forces ramped in at its segment's start and held, the
+    whole simulated with contact, then the tract, formants and sound (WAV, TextGrid, HDF5)."""
+    from ..stages import speak as speak_stage
+
+    check_number("--budget", budget, ge=1)
+    check_number("--jobs", jobs, ge=1)
+    for opt, p, ext in (("--plot", plot, ".png"), ("--animate", animate, ".gif")):
+        if p is not None and (p.suffix.lower() != ext or not p.parent.is_dir()):
+            raise ArticError(f"{opt} {p}: give a {ext} file in an existing folder")
+    say = lambda m: err_console.print(m, highlight=False)  # noqa: E731
+    res = with_progress("simulating", lambda update: speak_stage.speak(
+        utterance, out, maps, mesh, acoustic_maps, config, solutions, accept_nearest, budget, update, say, jobs,
+        dynamic))
+    _report(res)
+    if plot is not None or animate is not None:
+        _draw(res.paths, plot, animate, mesh, config)
+
+
+def _report(res) -> None:
+    if res.up_to_date:
+        out_console.print(f"{res.paths['wav']} is up to date (same utterance, solutions, mesh, config and code)",
+                          highlight=False)
+        return
+    s = res.spoken
+    out_console.print(f"wrote {res.paths['wav']} ({len(s.audio.samples) / s.audio.sample_rate_hz:.2f} s), "
+                      f"{res.paths['textgrid']}, {res.paths['h5']}", highlight=False)
+    for lab, how in zip(s.plan.labels, s.plan.notes):
+        out_console.print(f"  {lab}: {how}", highlight=False)
+
+
+def _draw(files: dict, plot: Path | None, animate: Path | None, mesh: Path, config: Path | None) -> None:
+    from ..io.wav import read_wav
+    from ..stages import speak as speak_stage
+
+    rec = speak_stage.read(files["h5"])
+    if plot is not None:
+        from ..plots.utterance import plot_utterance
+
+        y, rate = read_wav(files["wav"])
+        out_console.print(f"wrote {plot_utterance(rec, y, rate, plot)}", highlight=False)
+    if animate is not None:
+        from ..plots.utterance import animate_utterance
+        from ..stages.simulate import load_model
+
+        model, _, wall = load_model(mesh, config)
+        out_console.print(f"wrote {animate_utterance(rec, model, wall, animate)}", highlight=False)
