@@ -20,7 +20,7 @@ from pathlib import Path  # noqa: E402
 from artic_cli.config import load_config  # noqa: E402
 from artic_cli.geometry.mesh import tongue_mesh  # noqa: E402
 from artic_cli.geometry.wall import wall_surface  # noqa: E402
-from artic_cli.mechanics import integrator  # noqa: E402
+from artic_cli.mechanics import contact  # noqa: E402
 from artic_cli.mechanics.loads import muscle_force_vector  # noqa: E402
 from artic_cli.mechanics.model import Control, build_articulator  # noqa: E402
 from artic_cli.mechanics.simulate import run, settle  # noqa: E402
@@ -37,7 +37,7 @@ def main() -> None:
     ctl = Control(node_force=np.zeros((model.n_nodes, 3)), muscle_force=muscle_force_vector(model, {"SG": 4.0, "JO": 3.0}))
     spent = {"contact": 0.0}
     for name in ("contact_planes", "contact_forces", "enforce"):
-        fn = getattr(integrator, name)
+        fn = getattr(contact, name)
 
         def timed(*a, _fn=fn, **k):
             t0 = time.perf_counter()
@@ -46,7 +46,7 @@ def main() -> None:
             finally:
                 spent["contact"] += time.perf_counter() - t0
 
-        setattr(integrator, name, timed)
+        setattr(contact, name, timed)
     run(model, rest, lambda t: ctl, 0.3)  # warm-up: compiled loops loaded, caches filled
     walls, shares = [], []
     for _ in range(REPEATS):

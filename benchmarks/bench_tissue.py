@@ -66,7 +66,7 @@ def main() -> None:
     best, med = min(walls), statistics.median(walls)
 
     timers = Timers()
-    timers.wrap(integrator, "internal_forces", "forces (cylinders + volume)")
+    timers.wrap(integrator, "forces", "forces (every term)")
     timers.wrap(integrator, "tangent", "tangent assembly")
     timers.wrap(integrator, "factorize", "banded Cholesky factorisation")
     orig_solve = assembly.BandFactor.solve
@@ -76,7 +76,7 @@ def main() -> None:
     assembly.BandFactor.solve = orig_solve
 
     ratio = med / duration
-    print(f"tissue model: 231 nodes, {len(model.springs.i)} cylinders, band half-width {model.pattern.u}, "
+    print(f"tissue model: 231 nodes, {len(model.springs.i)} cylinders, band half-width {model.layout.pattern.u}, "
           f"dt = {model.options.dt * 1e3:g} ms, {traj.stats['steps']} steps")
     print(f"300 ms simulation: median {med * 1e3:.1f} ms, best {best * 1e3:.1f} ms wall (7 runs); "
           f"afterwards volumes, energies and inversion checks of all frames: {statistics.median(diag) * 1e3:.1f} ms")

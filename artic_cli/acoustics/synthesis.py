@@ -44,6 +44,48 @@ def _leaky_integral(x, gain, keep):
 
 
 @njit(cache=True)
+def _areas_at(frame_areas, pos, area):  # pragma: no cover - compiled
+    """The sections' areas at fractional frame ``pos`` (linear between frames, at least MIN_AREA_CM2)."""
+    n = frame_areas.shape[1]
+    k0 = int(pos)
+    if k0 >= frame_areas.shape[0] - 1:
+        k0 = frame_areas.shape[0] - 2 if frame_areas.shape[0] > 1 else 0
+    w = pos - k0 if frame_areas.shape[0] > 1 else 0.0
+    for j in range(n):
+        a = (1.0 - w) * frame_areas[k0, j] + (w * frame_areas[k0 + 1, j] if frame_areas.shape[0] > 1 else 0.0)
+        area[j] = a if a > MIN_AREA_CM2 else MIN_AREA_CM2
+
+
+@njit(cache=True)
+def _branch_step(branch_areas, bf, bb, new_bf, new_bb, keep):  # pragma: no cover - compiled
+    """One sample of the side branch's own junctions (its far end closed), ``new_bf[0]`` set by the caller."""
+    m = branch_areas.shape[0]
+    for k in range(m - 1):
+        r = (branch_areas[k] - branch_areas[k + 1]) / (branch_areas[k] + branch_areas[k + 1])
+        new_bf[k + 1] = (1.0 + r) * bf[k] - r * bb[k + 1]
+        new_bb[k] = r * bf[k] + (1.0 - r) * bb[k + 1]
+    new_bb[m - 1] = bf[m - 1]  # its far end is closed
+    for k in range(m):
+        bf[k] = keep * new_bf[k]
+        bb[k] = keep * new_bb[k]
+
+
+@njit(cache=True)
+def _lips_reflect(a_l, f_now, last_f, last_b, rho, c, fs):  # pragma: no cover - compiled
+    """The wave reflected at the lips: the radiation load, a parallel R-L (Flanagan), by the bilinear
+    transform of its reflection filter, from the forward wave now and the last sample's two waves."""
+    pi = np.pi
+    zc = rho * c / a_l
+    r_rad = 128.0 * rho * c / (9.0 * pi * pi * a_l)
+    k_rad = 2.0 * fs * 8.0 * rho / (3.0 * pi * np.sqrt(pi * a_l))
+    b0 = k_rad * (r_rad - zc) - zc * r_rad
+    b1 = -k_rad * (r_rad - zc) - zc * r_rad
+    a0 = k_rad * (r_rad + zc) + zc * r_rad
+    a1 = -k_rad * (r_rad + zc) + zc * r_rad
+    return (b0 * f_now + b1 * last_f - a1 * last_b) / a0
+
+
+@njit(cache=True)
 def _line(frame_areas, frame_index, source, glottal_reflection, rho, c, fs, loss, branch_at,
           branch_areas, noise, noise_at, wall_m, wall_r, wall_k):  # pragma: no cover - compiled
     n_samples = source.shape[0]
@@ -70,14 +112,7 @@ def _line(frame_areas, frame_index, source, glottal_reflection, rho, c, fs, loss
     dt = 1.0 / fs
     dx = c / fs
     for s in range(n_samples):
-        pos = frame_index[s]
-        k0 = int(pos)
-        if k0 >= frame_areas.shape[0] - 1:
-            k0 = frame_areas.shape[0] - 2 if frame_areas.shape[0] > 1 else 0
-        w = pos - k0 if frame_areas.shape[0] > 1 else 0.0
-        for j in range(n):
-            a = (1.0 - w) * frame_areas[k0, j] + (w * frame_areas[k0 + 1, j] if frame_areas.shape[0] > 1 else 0.0)
-            area[j] = a if a > MIN_AREA_CM2 else MIN_AREA_CM2
+        _areas_at(frame_areas, frame_index[s], area)
         new_f[0] = glottal_reflection * bwd[0] + source[s] / area[0]
         for j in range(n - 1):  # each junction's pressure p / (rho c) = f + b from the flows U = A (f - b) into it
             a_sum = area[j] + area[j + 1]
@@ -103,23 +138,9 @@ def _line(frame_areas, frame_index, source, glottal_reflection, rho, c, fs, loss
             new_f[k_n + 1] += half
             new_b[k_n] -= half
         if m > 0:
-            for k in range(m - 1):
-                r = (branch_areas[k] - branch_areas[k + 1]) / (branch_areas[k] + branch_areas[k + 1])
-                new_bf[k + 1] = (1.0 + r) * bf[k] - r * bb[k + 1]
-                new_bb[k] = r * bf[k] + (1.0 - r) * bb[k + 1]
-            new_bb[m - 1] = bf[m - 1]  # its far end is closed
-            for k in range(m):
-                bf[k] = keep * new_bf[k]
-                bb[k] = keep * new_bb[k]
+            _branch_step(branch_areas, bf, bb, new_bf, new_bb, keep)
         a_l = area[n - 1]
-        zc = rho * c / a_l
-        r_rad = 128.0 * rho * c / (9.0 * pi * pi * a_l)
-        k_rad = 2.0 * fs * 8.0 * rho / (3.0 * pi * np.sqrt(pi * a_l))
-        b0 = k_rad * (r_rad - zc) - zc * r_rad
-        b1 = -k_rad * (r_rad - zc) - zc * r_rad
-        a0 = k_rad * (r_rad + zc) + zc * r_rad
-        a1 = -k_rad * (r_rad + zc) + zc * r_rad
-        new_b[n - 1] = (b0 * fwd[n - 1] + b1 * last_f - a1 * last_b) / a0
+        new_b[n - 1] = _lips_reflect(a_l, fwd[n - 1], last_f, last_b, rho, c, fs)
         last_f = fwd[n - 1]
         last_b = new_b[n - 1]
         u = area[n - 1] * (fwd[n - 1] - new_b[n - 1]) if a_l > 2e-4 else 0.0  # closed lips radiate nothing

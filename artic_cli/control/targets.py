@@ -111,13 +111,17 @@ def _formant_doc(target: TargetSpec, f_hz, extra: dict | None = None) -> dict:
     return d
 
 
+def _voiced_candidate(c: Candidate) -> dict:
+    d = _cand(c)
+    d.pop("crucial_error_cm")
+    return dict(d, predicted_formants_hz=[_num(v) for v in c.detail["formants_hz"]], bark_error=_num(c.crucial_error))
+
+
 def solve_acoustic(ctx: Context, target: TargetSpec, voicer=None, verify: bool = False, refine: bool = False,
                    budget: int = 8) -> dict:
     """An acoustic target: candidates from the EPs' formants, checked (``verify``) or corrected (``refine``)
     by ``voicer.voice(jaw_forces, forces, lips, port) -> dict(formants_hz, reached_cm, area_function)``."""
-    from .acoustic_solver import nearest_candidate, solve_acoustic_on, within
-    from .verify import free_forces, map_jacobian, broyden, top_force
-    from ..units import hz_to_bark
+    from .acoustic_solver import nearest_candidate, solve_acoustic_on
 
     if ctx.formants is None:
         raise ArticError(f"target '{target.name}': acoustic targets need the formants of the maps' EPs; give "
@@ -127,44 +131,45 @@ def solve_acoustic(ctx: Context, target: TargetSpec, voicer=None, verify: bool =
     port = ctx.port_default if target.velum_port_cm2 is None else float(target.velum_port_cm2)
     formants = ctx.formants(jaw, lips[0], lips[1], port)
     head = {"target": target.name,
-           "jaw": {"forces_n": {k: _num(v) for k, v in jm.forces.items()}, "incisor_height_cm": _num(jm.rest[2, 1]),
-                   "maps": f"simulated maps of jaw position {jaw}"},
-           "acoustic": {"formants_hz": [float(v) for v in target.acoustic.formants_hz],
-                        "tolerance_pct": target.acoustic.tolerance_pct},
-           "lips": {"area_cm2": _num(lips[0]), "length_cm": _num(lips[1])}, "velum_port_cm2": _num(port)}
-    def voiced_cand(c: Candidate) -> dict:
-        d = _cand(c)
-        d.pop("crucial_error_cm")
-        return dict(d, predicted_formants_hz=[_num(v) for v in c.detail["formants_hz"]], bark_error=_num(c.crucial_error))
-
+            "jaw": {"forces_n": {k: _num(v) for k, v in jm.forces.items()}, "incisor_height_cm": _num(jm.rest[2, 1]),
+                    "maps": f"simulated maps of jaw position {jaw}"},
+            "acoustic": {"formants_hz": [float(v) for v in target.acoustic.formants_hz],
+                         "tolerance_pct": target.acoustic.tolerance_pct},
+            "lips": {"area_cm2": _num(lips[0]), "length_cm": _num(lips[1])}, "velum_port_cm2": _num(port)}
     try:
         cands = solve_acoustic_on(jm, target, formants, widen=refine)
     except UnreachableTarget as err:  # the answer is still the nearest force set the maps know
         near = nearest_candidate(jm, target, formants)
         if near is not None:
-            err.answer = dict(head, nearest=voiced_cand(near))
+            err.answer = dict(head, nearest=_voiced_candidate(near))
             if (verify or refine) and voicer is not None:  # ... and what it really gives
                 v = voicer.voice(dict(jm.forces), near.forces, lips, port)
                 err.answer["verified"] = _formant_doc(target, v["formants_hz"], {
                     "forces_n": {k: _num(f) for k, f in near.forces.items()}, "reached_cm": v["reached_cm"],
                     "area_function": v["area_function"], "simulations": 1})
         raise
-    chosen = cands[0]
-    doc = dict(head, chosen=voiced_cand(chosen), candidates=[voiced_cand(c) for c in cands[:TOP]],
+    doc = dict(head, chosen=_voiced_candidate(cands[0]), candidates=[_voiced_candidate(c) for c in cands[:TOP]],
                candidates_considered=len(cands))
     if not (verify or refine):
         return doc
-    jaw_forces = dict(jm.forces)
-
-    def voiced(forces):
-        return voicer.voice(jaw_forces, forces, lips, port)
-
-    first = voiced(chosen.forces)
+    voiced = lambda forces: voicer.voice(dict(jm.forces), forces, lips, port)  # noqa: E731
+    first = voiced(cands[0].forces)
     doc["verified"] = _formant_doc(target, first["formants_hz"], {"reached_cm": first["reached_cm"],
                                                                   "area_function": first["area_function"],
                                                                   "simulations": 1})
-    if not refine:
-        return doc
+    if refine:
+        doc["refined"] = _refine_acoustic(jm, target, cands, formants, voiced, first, budget)
+    return doc
+
+
+def _refine_acoustic(jm, target: TargetSpec, cands: list[Candidate], formants, voiced, first: dict,
+                     budget: int) -> dict:
+    """Broyden steps on F1/F2 in Bark from the best candidates in turn (the first Jacobian from their map
+    cells), within ``budget`` simulations in all; the best result, converged or not."""
+    from ..units import hz_to_bark
+    from .acoustic_solver import within
+    from .verify import broyden, free_forces, map_jacobian, top_force
+
     goal = hz_to_bark(np.asarray(target.acoustic.formants_hz[:2], dtype=float))
 
     def measure(forces):
@@ -192,12 +197,11 @@ def solve_acoustic(ctx: Context, target: TargetSpec, voicer=None, verify: bool =
         if within(target, r.extra["formants_hz"]):
             break
     r, cand = best
-    doc["refined"] = _formant_doc(target, r.extra["formants_hz"], {
+    return _formant_doc(target, r.extra["formants_hz"], {
         "from": f"{cand.family} {cand.name}", "candidates_tried": tried,
         "forces_n": {k: _num(v) for k, v in r.forces.items()}, "reached_cm": r.extra["reached_cm"],
         "area_function": r.extra["area_function"], "bark_error": _num(r.error), "simulations": budget - left,
         "converged": within(target, r.extra["formants_hz"])})
-    return doc
 
 
 def solve(ctx: Context, target: TargetSpec, simulator=None, verify: bool = False, refine: bool = False,

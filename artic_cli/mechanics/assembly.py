@@ -330,27 +330,38 @@ class NodeAssembly:
     def n_pairs(self) -> int:
         return len(self.pairs)
 
-    def blocks(self, n_nodes: int, cyl: tuple, k_cyl: np.ndarray, bricks: np.ndarray, grad: np.ndarray,
-               w: np.ndarray, seg: tuple, k_seg: np.ndarray) -> np.ndarray:
-        """Node-level blocks (numpy; the terms' compiled loops :func:`.elements.cylinder_blocks`,
-        :func:`.volume.brick_blocks` and :func:`.muscles.segment_blocks` compute the same): two-node elements (i, j) with 3x3 blocks k give k on both diagonals and -k on their pair;
-        bricks give w g_a g_b^T for every two corners (``grad`` (B,8,3))."""
+    def add_pairs(self, out: np.ndarray, i: np.ndarray, j: np.ndarray, pair: np.ndarray, k: np.ndarray) -> None:
+        """Add two-node elements' 3x3 blocks ``k`` (E, 3, 3) to node-level blocks ``out`` (P + N, 3, 3): k on
+        both diagonals, -k on their pair (numpy; the terms' compiled loops compute the same)."""
+        if len(k) == 0:
+            return
         p = self.n_pairs
-        out = np.zeros((p + n_nodes, 3, 3))
-        for (i, j), pair, k in ((cyl, self.cyl_pair, k_cyl), (seg, self.seg_pair, k_seg)):
-            if len(k) == 0:
-                continue
-            np.add.at(out, p + i, k)
-            np.add.at(out, p + j, k)
-            np.add.at(out, pair, -k)
-        if len(grad):
-            gg = w[:, None, None, None, None] * grad[:, :, None, :, None] * grad[:, None, :, None, :]  # (B,8,8,3,3)
-            na, nb = bricks[:, :, None], bricks[:, None, :]
-            upper = np.broadcast_to(na < nb, gg.shape[:3])
-            diag = np.broadcast_to(np.eye(8, dtype=bool), gg.shape[:3])
-            np.add.at(out, self.brick_pair[upper], gg[upper])
-            np.add.at(out, p + np.broadcast_to(na, gg.shape[:3])[diag], gg[diag])
-        return out
+        np.add.at(out, p + i, k)
+        np.add.at(out, p + j, k)
+        np.add.at(out, pair, -k)
+
+    def add_bricks(self, out: np.ndarray, bricks: np.ndarray, grad: np.ndarray, w: np.ndarray) -> None:
+        """Add w g_a g_b^T for every two corners of every brick (``grad`` (B, 8, 3)) to ``out``."""
+        if not len(grad):
+            return
+        gg = w[:, None, None, None, None] * grad[:, :, None, :, None] * grad[:, None, :, None, :]  # (B,8,8,3,3)
+        na, nb = bricks[:, :, None], bricks[:, None, :]
+        upper = np.broadcast_to(na < nb, gg.shape[:3])
+        diag = np.broadcast_to(np.eye(8, dtype=bool), gg.shape[:3])
+        np.add.at(out, self.brick_pair[upper], gg[upper])
+        np.add.at(out, self.n_pairs + np.broadcast_to(na, gg.shape[:3])[diag], gg[diag])
+
+
+@dataclass(frozen=True)
+class Layout:
+    """The solver's fixed view of a model, made once when it is built: the band pattern of the reduced
+    unknowns, where element blocks land in it, the consistent mass in its flat storage, and the scatter of
+    the cylinders' force vectors onto the nodes."""
+
+    pattern: BandPattern
+    assembly: NodeAssembly
+    mass_flat: np.ndarray  # M in flat storage (BandPattern.unpack)
+    scatter: sp.csr_matrix  # (N, C): node force = scatter @ (T n)
 
 
 def node_assembly(pattern: "BandPattern", n_nodes: int, cyl_edges: np.ndarray, bricks: np.ndarray,

@@ -27,6 +27,7 @@ from functools import cached_property
 import numpy as np
 
 from ..geometry.wall import PARTS, WallSurface
+from .term import Evaluation, ForceTerm
 from .wall_query import CandidateGrid, candidate_grid, wall_query
 
 
@@ -115,3 +116,65 @@ def enforce(cm: ContactModel, x: np.ndarray, v: np.ndarray):
     vn = (v[idx] * n[bad]).sum(axis=1)
     v[idx] -= np.maximum(vn, 0.0)[:, None] * n[bad]
     return x, v, int(bad.sum()), None
+
+
+def contact_forces(cm: ContactModel, x: np.ndarray, planes: ContactPlanes | None):
+    """Penalty forces (N, 3) of the nodes beyond their step's wall planes, which are active, and their
+    magnitudes (dyn); the reaction of the mandible's planes acts on its frame nodes."""
+    f = np.zeros_like(x)
+    if planes is None or len(planes.nodes) == 0:
+        return f, np.zeros(0, dtype=bool), np.zeros(0)
+    g = planes.gaps(x)
+    active = g > 0
+    mag = cm.stiffness * np.where(active, g, 0.0)
+    push = mag[:, None] * planes.n
+    np.add.at(f, planes.nodes, -push)
+    on_jaw = planes.jaw & active
+    if on_jaw.any():  # the reaction acts on the mandible
+        f[planes.jaw_nodes] += push[on_jaw].sum(axis=0) / len(planes.jaw_nodes)
+    return f, active, mag
+
+
+class ContactTerm(ForceTerm):
+    """The wall: each step's tangent planes, a stiff penalty beyond them inside Newton (active contacts as
+    rank-one terms, so a change of the contact set does not refactor the band), and after the step the
+    guarantee: nodes still beyond the true surface are projected back onto it."""
+
+    name = "contact"
+
+    def present(self, model) -> bool:
+        return model.contact is not None
+
+    def prepare(self, model, state, control, h: float) -> ContactPlanes:
+        cached = state.wall_cache is not None and state.wall_cache[0] is state.x
+        return contact_planes(model.contact, state.x, state.wall_cache[1] if cached else None)
+
+    def forces(self, model, ev: Evaluation, f: np.ndarray) -> None:
+        fc, active, _ = contact_forces(model.contact, ev.x, ev.step[self.name])
+        ev.parts[self.name] = active
+        f += fc
+
+    def rank_one(self, model, ev: Evaluation):
+        planes, active = ev.step[self.name], ev.parts[self.name]
+        if not active.any():
+            return None
+        nodes, n = planes.nodes[active], planes.n[active]
+        v = np.zeros((model.n_nodes, 3, len(nodes)))
+        v[nodes, :, np.arange(len(nodes))] = n
+        for c in np.flatnonzero(planes.jaw[active]):  # the reaction on the mandible's frame
+            v[planes.jaw_nodes, :, c] -= n[c] / len(planes.jaw_nodes)
+        return v.reshape(3 * model.n_nodes, -1), np.full(len(nodes), model.contact.stiffness)
+
+    def key(self, model, ev: Evaluation) -> tuple:
+        return tuple(ev.step[self.name].nodes[ev.parts[self.name]])
+
+    def constrain(self, model, ev: Evaluation, x: np.ndarray, v: np.ndarray):
+        """The contact forces at the step's end, then nodes beyond the wall by more than the tolerance put back
+        on it (a mirrored node has no dofs: a projection of its own would stay with it for good, so the
+        mirror images are set again)."""
+        _, active, mag = contact_forces(model.contact, x, ev.step[self.name])
+        record = {"contact_nodes": ev.step[self.name].nodes[active], "contact_force": mag[active]}
+        x, v, projected, query = enforce(model.contact, x, v)
+        model.mirror(x)
+        model.mirror(v)
+        return x, v, dict(record, projected=projected, wall_cache=None if query is None else (x, query))

@@ -34,6 +34,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..jit import compiled, njit
+from .term import Evaluation, ForceTerm
 
 
 @dataclass(frozen=True)
@@ -192,6 +193,37 @@ def strain_energy(cyl: CylinderSet, strain: np.ndarray, points: int = 8) -> np.n
         density = np.where(st / dd < 1.0, st**2 / 2.0 - st**3 / (6.0 * dd), dd**2 / 3.0 + dd * (st - dd) / 2.0)
         energy[slack] = (cyl.area0 * cyl.l0 * np.broadcast_to(cyl.youngs, strain.shape))[slack] * density
     return energy
+
+
+# --- the term ----------------------------------------------------------------------------------------------
+
+class CylinderTerm(ForceTerm):
+    """Every Voigt element of the model (tongue cylinders, bone links, the floor, jaw springs): elastic
+    tension and the step's dashpots; tangent (K_ax - T/l) n n^T + T/l I + c_v c n0 n0^T per element."""
+
+    name = "cylinders"
+
+    def prepare(self, model, state, control, h: float) -> DampingFrame:
+        return damping_frame(model.springs, state.x)
+
+    def forces(self, model, ev: Evaluation, f: np.ndarray) -> None:
+        cs = evaluate(model.springs, ev.x)
+        ev.parts[self.name] = cs
+        f += nodal_forces(model.springs, cs, ev.step[self.name], ev.v, model.layout.scatter)
+
+    def blocks(self, model, ev: Evaluation, out: np.ndarray, signed: bool = True) -> None:
+        cyl, cs, frame, asm = model.springs, ev.parts[self.name], ev.step[self.name], model.layout.assembly
+        axial = axial_stiffness(cyl, cs)
+        if compiled():
+            cylinder_blocks(out, cs.n, cs.length, cs.elastic, axial, frame.n, frame.c, ev.c_v, signed, cyl.i, cyl.j,
+                            asm.cyl_pair, asm.n_pairs)
+            return
+        k_geo = (cs.elastic if signed else np.maximum(cs.elastic, 0.0)) / cs.length
+        k_nn = np.maximum(axial, 0.0) - k_geo
+        k3 = (k_nn[:, None, None] * (cs.n[:, :, None] * cs.n[:, None, :]) + k_geo[:, None, None] * np.eye(3)
+              + (ev.c_v * frame.c)[:, None, None] * (frame.n[:, :, None] * frame.n[:, None, :]))
+        asm.add_pairs(out, cyl.i, cyl.j, asm.cyl_pair, k3)
+
 
 
 # --- compiled loops (numba): the same numbers as the numpy path above ---------------------------------

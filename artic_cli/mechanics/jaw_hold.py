@@ -14,7 +14,8 @@ import dataclasses
 
 import numpy as np
 
-from .model import Guide, Model, State
+from .guide import Guide, with_flat
+from .model import Model, State
 
 FRAME = ("condyle", "coronoid", "gonion", "symphysis")
 
@@ -33,8 +34,7 @@ def hold_jaw(model: Model, x: np.ndarray) -> Model:
     k = model.guide.stiffness
     guide = Guide(nodes=nodes, origin=np.asarray(x, dtype=float)[nodes].copy(), normals=normals, stiffness=k,
                   path=None, onset=model.guide.onset)
-    flat = model.pattern.diagonal_operator(nodes) @ (k * np.einsum("gmi,gmj->gij", normals, normals)).ravel()
-    return dataclasses.replace(model, guide=guide, guide_flat=flat)
+    return dataclasses.replace(model, guide=with_flat(guide, model.layout.pattern))
 
 
 def fresh_start(state: State) -> State:

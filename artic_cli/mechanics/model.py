@@ -1,8 +1,9 @@
 """Model (static), State (changes every step) and Control (inputs over time).
 
 As in MuJoCo's mjModel / mjData and Warp's Model / State / Control, the
-static model holds topology, rest geometry, materials, muscle routing and the
-solver's fixed sparsity pattern; the state holds positions, velocities, the
+static model holds topology, rest geometry, materials, muscle routing, the force
+terms it sums (:mod:`.term`) and the solver's fixed layout (:class:`.assembly.Layout`);
+the state holds positions, velocities, the
 integrator's history, the muscles' internal (Maxwell) state and a scratch
 factorisation; the control holds the external nodal forces and the muscle
 forces of the current step.  Everything is CGS inside (cm, g, s, dyn).
@@ -29,17 +30,24 @@ from ..geometry.hexahedra import corner_jacobians, volumes
 from ..geometry.mesh import Mesh
 from ..geometry.mirror import MIRROR, mirror_images
 from ..geometry.wall import WallSurface
-from .assembly import BandFactor, BandPattern, NodeAssembly, band_pattern, node_assembly
+from .assembly import BandFactor, Layout, band_pattern, node_assembly
 from .calibration import calibrate
-from .contact import ContactModel, contact_model
-from .elements import CylinderSet
+from .contact import ContactModel, ContactTerm, contact_model
+from .elements import CylinderSet, CylinderTerm
+from .external import ExternalTerm
+from .guide import Guide, GuideTerm, with_flat
 from .isotropy import isotropic_areas
-from .muscles import MuscleSet, fibre_twins, muscle_set
+from .muscles import MuscleSet, MuscleTerm, fibre_twins, muscle_set
 from .prestress import weight_carrying
+from .term import ForceTerm
+from .volume import VolumeTerm
 
 
 
 CONTROL_POINTS = ("tip", "dorsum", "jaw")  # the names of the EMA-style control points, in this order
+# the force terms a model sums, in this order (each where the model has its physics)
+FORCE_TERMS: tuple[ForceTerm, ...] = (CylinderTerm(), VolumeTerm(), GuideTerm(), MuscleTerm(), ContactTerm(),
+                                      ExternalTerm())
 
 @dataclass(frozen=True)
 class SolverOptions:
@@ -48,24 +56,6 @@ class SolverOptions:
     tol: float = 1e-5  # cm, Newton increment
     max_iter: int = 25
     refactor_rate: float = 0.25
-
-
-@dataclass(frozen=True)
-class Guide:
-    """Nodes held on lines: force -k sum_m ((x - x0) . m) m over the normals m.
-
-    With ``path`` (the line's forward direction) the line ends at ``x0``: a
-    node behind it (s = (x - x0) . path < 0, the condyle pressed into the back
-    of the glenoid fossa) is pushed forward with k ramp(-s) path, the penalty
-    of :mod:`.penalty` with a smoothed onset over ``onset`` cm.
-    """
-
-    nodes: np.ndarray  # (G,)
-    origin: np.ndarray  # (G,3)
-    normals: np.ndarray  # (G,2,3)
-    stiffness: float  # dyn/cm
-    path: np.ndarray | None = None  # (G,3) forward unit vectors: a one-sided stop at the origin
-    onset: float = 0.0  # cm over which the stop's force rises smoothly
 
 
 @dataclass(frozen=True)
@@ -108,12 +98,9 @@ class Model:
     node_mass: np.ndarray  # (N,)
     gravity: np.ndarray  # (3,) cm/s^2
     fixed: np.ndarray  # (N,3) bool
-    pattern: BandPattern
-    assembly: NodeAssembly  # node pairs and the operator from node-level blocks to flat storage
-    mass_flat: np.ndarray  # M in flat storage (BandPattern.unpack)
-    guide_flat: np.ndarray  # the condyle guide's constant stiffness in flat storage
-    scatter: sp.csr_matrix  # (N, C): node force = scatter @ (T n)
+    layout: Layout  # the solver's fixed pattern, block placement, mass and scatter
     options: SolverOptions = field(default_factory=SolverOptions)
+    force_terms: tuple[ForceTerm, ...] = FORCE_TERMS  # what step() sums (each present one)
     node_sets: dict = field(default_factory=dict)
     names: dict = field(default_factory=dict)
     muscles: MuscleSet | None = None
@@ -128,6 +115,11 @@ class Model:
     image: np.ndarray | None = None  # (N,) each node's mirror image, when the right half is solved for both
     mirrored: np.ndarray | None = None  # (H,) the nodes that move as their image's mirror (no dofs of their own)
     fibre_twin: np.ndarray | None = None  # (F,) each fibre's mirror twin when mirrored (itself on the midline)
+
+    @property
+    def terms(self) -> tuple[ForceTerm, ...]:
+        """The force terms this model has (its wall, muscles, guide: when present)."""
+        return tuple(t for t in self.force_terms if t.present(self))
 
     def mirror(self, x: np.ndarray) -> np.ndarray:
         """``x`` (N,3) with each mirrored node put at its image's mirror place (in place, returned)."""
@@ -273,23 +265,21 @@ def _finish(mesh: Mesh, rest: np.ndarray, cyl: CylinderSet, link_mass: np.ndarra
     seg_edges = np.column_stack([ms.seg_i, ms.seg_j]) if ms is not None else np.zeros((0, 2), dtype=np.int64)
     asm = node_assembly(pattern, n, cyl_edges, mesh.bricks, seg_edges)
     eye = np.broadcast_to(np.eye(3), (len(cyl.i), 3, 3))
-    mblocks = asm.blocks(n, (cyl.i, cyl.j), (link_mass / 3.0)[:, None, None] * eye, mesh.bricks, np.zeros((0, 8, 3)),
-                         np.zeros(0), (seg_edges[:, 0], seg_edges[:, 1]), np.zeros((len(seg_edges), 3, 3)))
+    mblocks = np.zeros((asm.n_pairs + n, 3, 3))
+    asm.add_pairs(mblocks, cyl.i, cyl.j, asm.cyl_pair, (link_mass / 3.0)[:, None, None] * eye)
     mblocks[: asm.n_pairs] *= -0.5  # consistent mass: m/3 on the diagonal, m/6 between the two nodes
-    mass_flat = asm.operator @ mblocks.ravel()
-    guide_flat = np.zeros(pattern.size)
     ncyl = len(cyl.i)
     scatter = sp.csr_matrix((np.concatenate([np.ones(ncyl), -np.ones(ncyl)]),
                              (np.concatenate([cyl.i, cyl.j]), np.concatenate([np.arange(ncyl)] * 2))), shape=(n, ncyl))
     guide = extra.pop("guide_spec", None)
     if guide is not None:
         nodes, origin, normals, k, path, onset = guide
-        extra["guide"] = Guide(nodes=nodes, origin=origin, normals=normals, stiffness=k, path=path, onset=onset)
-        guide_flat = pattern.diagonal_operator(nodes) @ (k * np.einsum("gmi,gmj->gij", normals, normals)).ravel()
+        extra["guide"] = with_flat(Guide(nodes=nodes, origin=origin, normals=normals, stiffness=k, path=path,
+                                         onset=onset), pattern)
+    layout = Layout(pattern=pattern, assembly=asm, mass_flat=asm.operator @ mblocks.ravel(), scatter=scatter)
     return Model(mesh=mesh, rest=rest, springs=cyl, bricks=mesh.bricks, brick_v0=v0,
                  kappa=kappa, mass=mass, node_mass=node_mass, gravity=np.array([0.0, -gravity, 0.0]), fixed=fixed,
-                 pattern=pattern, assembly=asm, mass_flat=mass_flat, guide_flat=guide_flat,
-                 scatter=scatter, options=solver_options(sim), **extra)
+                 layout=layout, options=solver_options(sim), **extra)
 
 
 def build_model(mesh: Mesh, tissue: TissueMaterial, sim: Simulation, *,

@@ -25,6 +25,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..jit import compiled, njit
+from .term import Evaluation, ForceTerm
 
 FL_COEFFS = (22.5, 3.498, -14.718, 1.98, 0.858)  # Eq. (9), highest power first
 FL_RANGE = (-0.185, 0.49)
@@ -212,6 +213,83 @@ def muscle_tensions(ms: MuscleSet, x: np.ndarray, activation: np.ndarray, sigma2
     passive = ms.k1 * np.maximum(strain, 0.0) * strain + sigma2
     t = activation[ms.fibre_muscle] * ms.fibre_share * force_length(strain, ms.fl_width) + ms.fibre_area * passive
     return np.bincount(ms.fibre_muscle, weights=t, minlength=len(ms.names))
+
+
+# --- the term ----------------------------------------------------------------------------------------------
+
+# Fibres stiffer than this along their length (dyn/cm; active muscles on the steep side of Eq. 9) enter the
+# tangent exactly, as rank-one terms k g g^T solved by Woodbury; softer ones are split over their segments.
+RANK_ONE_STIFFNESS = 2.0e4
+
+
+def total_muscle_force(model, muscle_force: np.ndarray | None) -> np.ndarray | None:
+    """The control's muscle forces plus the model's postural tone (dyn), or None without muscles."""
+    if model.muscles is None:
+        return None
+    act = np.zeros(len(model.muscles.names)) if muscle_force is None else muscle_force
+    return act + model.tone if model.tone is not None else act
+
+
+def model_fibre_stiffness(model, fs: FibreState, act: np.ndarray, h: float) -> np.ndarray:
+    """(F,) the fibres' stiffness along their length (:func:`fibre_stiffness`); a mirrored model's twins get
+    their mean, so that both fall on the same side of the rank-one threshold."""
+    kf = fibre_stiffness(model.muscles, fs, act, h)
+    return kf if model.fibre_twin is None else 0.5 * (kf + kf[model.fibre_twin])
+
+
+class MuscleTerm(ForceTerm):
+    """The muscles' fibres: tension along their segments; in the tangent each segment's own block (its
+    tension sideways, a soft fibre's stiffness split in series) and stiff fibres whole as rank-one terms; the
+    Maxwell stress advanced after the step."""
+
+    name = "muscles"
+
+    def present(self, model) -> bool:
+        return model.muscles is not None
+
+    def prepare(self, model, state, control, h: float) -> np.ndarray:
+        return total_muscle_force(model, control.muscle_force)
+
+    def forces(self, model, ev: Evaluation, f: np.ndarray) -> None:
+        fs = fibre_state(model.muscles, ev.x, ev.step[self.name], ev.state.sigma2, ev.state.fibre_strain, ev.h)
+        ev.parts[self.name] = {"fs": fs}
+        f += muscle_forces(model.muscles, fs)
+
+    def stiffness(self, model, ev: Evaluation) -> np.ndarray:
+        part = ev.parts[self.name]
+        if "kf" not in part:
+            part["kf"] = model_fibre_stiffness(model, part["fs"], ev.step[self.name], ev.h)
+        return part["kf"]
+
+    def blocks(self, model, ev: Evaluation, out: np.ndarray, signed: bool = True) -> None:
+        ms, fs, asm = model.muscles, ev.parts[self.name]["fs"], model.layout.assembly
+        kf = self.stiffness(model, ev)
+        t = np.maximum(fs.tension[ms.seg_fibre], 0.0) / fs.seg_length
+        nn = fs.n[:, :, None] * fs.n[:, None, :]
+        soft = np.where(kf < RANK_ONE_STIFFNESS, kf * ms.fibre_l0, 0.0)  # split in series
+        k_seg = t[:, None, None] * (np.eye(3) - nn) + (soft[ms.seg_fibre] / ms.seg_l0)[:, None, None] * nn
+        if compiled():
+            segment_blocks(out, ms.seg_i, ms.seg_j, asm.seg_pair, k_seg, asm.n_pairs)
+        else:
+            asm.add_pairs(out, ms.seg_i, ms.seg_j, asm.seg_pair, k_seg)
+
+    def rank_one(self, model, ev: Evaluation):
+        """Stiff fibres along their whole length; in a mirrored model a fibre and its twin have one folded
+        gradient: they enter as one term of twice the stiffness (fewer Woodbury columns)."""
+        kf = self.stiffness(model, ev)
+        stiff = np.flatnonzero(kf >= RANK_ONE_STIFFNESS)
+        k = kf[stiff]
+        if model.fibre_twin is not None:  # twins' gradients fold onto the same column: one, twice as stiff
+            twin = model.fibre_twin[stiff]
+            keep = twin >= stiff
+            stiff, k = stiff[keep], np.where(twin[keep] == stiff[keep], 1.0, 2.0) * k[keep]
+        if not len(stiff):
+            return None
+        return length_gradients(model.muscles, ev.parts[self.name]["fs"], stiff, model.n_nodes), k
+
+    def advance(self, model, ev: Evaluation, x: np.ndarray) -> dict:
+        fs = fibre_state(model.muscles, x, ev.step[self.name], ev.state.sigma2, ev.state.fibre_strain, ev.h)
+        return {"sigma2": fs.sigma2, "fibre_strain": fs.strain}
 
 
 # --- compiled loops (numba): the same numbers as the numpy path above ---------------------------------

@@ -13,7 +13,8 @@ from threadpoolctl import threadpool_limits
 
 from ..geometry.hexahedra import corner_jacobians, volumes
 from .elements import strain_energy
-from .integrator import SimulationDiverged, step, total_muscle_force
+from .integrator import SimulationDiverged, step
+from .muscles import total_muscle_force
 from .model import Control, Model, State, rest_state, with_options, zero_control
 from .muscles import muscle_lengths, muscle_tensions
 from .volume import volume_energy

@@ -18,8 +18,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..jit import njit
-from ..geometry.hexahedra import corner_jacobians, corner_jacobians_at, volume_gradients, volumes
+from ..geometry.hexahedra import (SHAPE_GRADIENTS_CORNER, SHAPE_GRADIENTS_GAUSS, corner_jacobians, corner_jacobians_at,
+                                  volume_gradients, volumes)
+from ..jit import compiled, njit
+from .term import Evaluation, ForceTerm
 
 # Inversion guard: a corner whose Jacobian falls below this fraction f of its rest value is pushed back by
 # U = w / (3 f) (f - J / J0)^3, w = bulk modulus x V0 / 8 (one eighth of the brick per corner).  Cubic, so
@@ -61,6 +63,60 @@ def corner_guard(x: np.ndarray, bricks: np.ndarray, j0: np.ndarray, weight: np.n
     contrib = (weight[b] * depth**2 / GUARD_FRACTION)[:, None, None] * g  # -dU/dx
     np.add.at(f, bricks[b], contrib)
     return f, (b, c, g, 2.0 * weight[b] * depth / GUARD_FRACTION)
+
+
+# --- the term ----------------------------------------------------------------------------------------------
+
+class VolumeTerm(ForceTerm):
+    """The bricks: the volume penalty (when the constraint is on; Gauss-Newton tangent kappa/V0 g g^T in the
+    band) and the inversion guard (its active corners as rank-one terms)."""
+
+    name = "volume"
+
+    def forces(self, model, ev: Evaluation, f: np.ndarray) -> None:
+        nt, on = model.n_tongue, model.volume_constraint
+        grad = guard = None
+        if compiled() and model.corner_j0 is not None:
+            kappa = model.kappa if on else np.zeros_like(model.kappa)
+            fb, _, grad, pairs, g, w = brick_terms(np.ascontiguousarray(ev.x[:nt]), model.bricks, SHAPE_GRADIENTS_GAUSS,
+                                                   SHAPE_GRADIENTS_CORNER, model.brick_v0, kappa, model.corner_j0,
+                                                   model.guard_weight, GUARD_FRACTION)
+            f[:nt] += fb
+            guard = (pairs[:, 0], pairs[:, 1], g, w) if len(pairs) else None
+            grad = grad if on else None
+        else:
+            if on:
+                fv, _, grad = volume_forces(ev.x[:nt], model.bricks, model.brick_v0, model.kappa)
+                f[:nt] += fv
+            if model.corner_j0 is not None:
+                fg, guard = corner_guard(ev.x[:nt], model.bricks, model.corner_j0, model.guard_weight)
+                f[:nt] += fg
+        ev.parts[self.name] = (grad, guard)
+
+    def blocks(self, model, ev: Evaluation, out: np.ndarray, signed: bool = True) -> None:
+        grad = ev.parts[self.name][0]
+        if grad is None:
+            return
+        asm = model.layout.assembly
+        grad = grad.reshape(len(model.brick_v0), 8, 3)
+        w = model.kappa / model.brick_v0
+        if compiled():
+            brick_blocks(out, model.bricks, asm.brick_pair, grad, w, asm.n_pairs)
+        else:
+            asm.add_bricks(out, model.bricks, grad, w)
+
+    def rank_one(self, model, ev: Evaluation):
+        guard = ev.parts[self.name][1]
+        if guard is None:  # no corner near inversion
+            return None
+        b, _, g, w = guard
+        v = np.zeros((model.n_nodes, 3, len(b)))
+        np.add.at(v, (model.bricks[b], slice(None), np.arange(len(b))[:, None]), g)
+        return v.reshape(3 * model.n_nodes, -1), w
+
+    def key(self, model, ev: Evaluation) -> tuple:
+        guard = ev.parts[self.name][1]
+        return () if guard is None else tuple(zip(guard[0].tolist(), guard[1].tolist()))
 
 
 # --- compiled loops (numba): the same numbers as the numpy path above ---------------------------------

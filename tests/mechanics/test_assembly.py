@@ -3,15 +3,17 @@
 import numpy as np
 import pytest
 
-from artic_cli.mechanics import elements
-from artic_cli.mechanics.integrator import internal_forces
+from artic_cli import jit
 
 
 def test_compiled_kernels_give_the_numpy_numbers(art):
-    """The numba loops (cylinders, bricks, guard, fibres) reproduce the numpy path, including a guarded corner."""
-    from artic_cli import jit
-    from artic_cli.mechanics.integrator import tangent
-    from artic_cli.mechanics.muscles import fibre_state, length_gradients, muscle_forces
+    """The numba loops (cylinders, bricks, guard, fibres) reproduce the numpy path, including a guarded corner:
+    every term's forces, the banded tangent, fibre gradients and states."""
+    from dataclasses import replace
+
+    from artic_cli.mechanics.integrator import evaluation, forces, tangent
+    from artic_cli.mechanics.model import Control, rest_state
+    from artic_cli.mechanics.muscles import length_gradients, muscle_forces
 
     if not jit.AVAILABLE:
         pytest.skip("numba not installed: only the numpy path runs")
@@ -20,23 +22,24 @@ def test_compiled_kernels_give_the_numpy_numbers(art):
     b = art.bricks[7]
     x[b[6]] = x[b[0]] + 0.2 * (x[b[6]] - x[b[0]])  # squash one brick so that the guard acts
     v = rng.normal(0, 1.0, x.shape)
-    frame = elements.damping_frame(art.springs, art.rest)
-    act = np.full(len(art.muscle_names), 2.0e5)
     ms = art.muscles
+    start = replace(rest_state(art), sigma2=np.full(ms.n_fibres, 50.0), fibre_strain=np.full(ms.n_fibres, -0.01))
+    ctl = Control(node_force=np.zeros_like(x), muscle_force=np.full(len(art.muscle_names), 2.0e5))
     out = {}
     for flag in (False, True):
         jit.USE_KERNELS = flag
         try:
-            f, cs, vol, grad, guard = internal_forces(art, x, v, frame)
-            fs = fibre_state(ms, x, act, np.full(ms.n_fibres, 50.0), np.full(ms.n_fibres, -0.01), 0.005)
-            k = tangent(art, cs, frame, grad, fs, act, 0.005, 8e4, 367.0)
-            fibres = np.arange(0, ms.n_fibres, 7)
-            lg = length_gradients(ms, fs, fibres, art.n_nodes)
+            ev = evaluation(art, start, ctl, x, v, 0.005, 367.0)
+            f = forces(art, ev)
+            k = tangent(art, ev, 8e4)
+            grad, guard = ev.parts["volume"]
+            fs = ev.parts["muscles"]["fs"]
+            lg = length_gradients(ms, fs, np.arange(0, ms.n_fibres, 7), art.n_nodes)
             fm = muscle_forces(ms, fs)
         finally:
             jit.USE_KERNELS = True
-        out[flag] = (f, vol, grad, guard, k.band, k.b, k.c, lg, fm, fs.seg_length, fs.strain, fs.sigma2, fs.tension)
-    assert out[True][3] is not None and len(out[True][3][0]) == len(out[False][3][0]) > 0
+        out[flag] = (f, grad, guard, k.band, k.b, k.c, lg, fm, fs.seg_length, fs.strain, fs.sigma2, fs.tension)
+    assert out[True][2] is not None and len(out[True][2][0]) == len(out[False][2][0]) > 0
     for a, c in zip(out[False], out[True]):
         if isinstance(a, tuple):
             for p, q in zip(a, c):
@@ -54,7 +57,7 @@ def test_node_level_assembly_is_t_transpose_k_t_of_the_element_blocks(which, req
 
     art = request.getfixturevalue(which)
     rng = np.random.default_rng(11)
-    n, asm, pat, ms = art.n_nodes, art.assembly, art.pattern, art.muscles
+    n, asm, pat, ms = art.n_nodes, art.layout.assembly, art.layout.pattern, art.muscles
 
     def sym(k):
         a = rng.normal(size=(k, 3, 3))
@@ -62,7 +65,10 @@ def test_node_level_assembly_is_t_transpose_k_t_of_the_element_blocks(which, req
 
     k_cyl, k_seg = sym(len(art.springs.i)), sym(len(ms.seg_i))
     grad, w = rng.normal(size=(len(art.bricks), 8, 3)), rng.uniform(0.5, 2.0, len(art.bricks))
-    blocks = asm.blocks(n, (art.springs.i, art.springs.j), k_cyl, art.bricks, grad, w, (ms.seg_i, ms.seg_j), k_seg)
+    blocks = np.zeros((asm.n_pairs + n, 3, 3))
+    asm.add_pairs(blocks, art.springs.i, art.springs.j, asm.cyl_pair, k_cyl)
+    asm.add_bricks(blocks, art.bricks, grad, w)
+    asm.add_pairs(blocks, ms.seg_i, ms.seg_j, asm.seg_pair, k_seg)
     mat = pat.unpack(asm.operator @ blocks.ravel())
     g = grad.reshape(len(w), 24)
     dense = (sparse_blocks(np.column_stack([art.springs.i, art.springs.j]), pair_blocks(k_cyl), n)
