@@ -195,7 +195,7 @@ def test_every_definite_direction_is_tested():
 
 def test_sg_first_brings_the_dorsum_onto_the_palate_between_0_5_and_2_n(art, cfg):
     """SG alone, jaw held at rest as the maps hold it: no contact at 0.5 N, the dorsum region on the wall by 2 N
-    (the paper: about 1 N; ours 1.5 N with the default speaker's palate, 4 N with anatomy.md's)."""
+    (the paper: about 1 N; ours 1.5 N with the default speaker's palate, 4 N with a smooth vault, docs/speaker.md)."""
     row = k_closure(art, forces=(0.5, 1.0, 1.5, 2.0), hold=cfg.epmap.hold_jaw, reach=False)[0]
     assert row.ours in (1.0, 1.5, 2.0), row.note
 
