@@ -13,7 +13,7 @@ from .common import save_figure
 
 
 def plot_utterance(record, samples: np.ndarray, sample_rate_hz: int, path: Path | str, max_hz: float = 8000.0) -> Path:
-    """``record``: :class:`artic_cli.stages.speak.Record`; ``samples``: its WAV."""
+    """``record``: :class:`artic_cli.speech.record.Record`; ``samples``: its WAV."""
     nper = max(16, int(0.006 * sample_rate_hz))
     f, t, sxx = spectrogram(samples, sample_rate_hz, nper, nper * 3 // 4, max(512, nper))
     db = 10 * np.log10(np.maximum(sxx, 1e-20))

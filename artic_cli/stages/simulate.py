@@ -20,6 +20,7 @@ from ..io.fingerprint import digest
 from ..io.store import Provenance, atomic_h5, open_artifact
 from ..mechanics.loads import load_program
 from ..mechanics.model import ARTICULATOR_SECTIONS, Model, build_articulator, build_model, rest_state
+from ..mechanics.record import Contacts, Simulation, node_parts
 from ..mechanics.simulate import Trajectory, problems, run, settle
 from ..schedule import Schedule, load_schedule
 from ..validation import check_number
@@ -159,47 +160,6 @@ def write(path: Path | str, traj: Trajectory, model: Model, prov: Provenance | N
             g.create_dataset("nodes", data=np.concatenate(traj.contact_nodes).astype(np.int64))
             g.create_dataset("force", data=units.dyn_to_newton(np.concatenate(traj.contact_forces))).attrs["units"] = "N"
             g.attrs["layout"] = "frame k: nodes[offsets[k]:offsets[k+1]] with force[...] (N)"
-
-
-def node_parts(model: Model) -> dict[str, np.ndarray]:
-    """Which nodes are the tongue, the mandible and the hyoid (the rest are fixed or carried points)."""
-    parts = {"tongue": np.arange(model.n_tongue)}
-    for name in ("mandible", "hyoid"):
-        if name in model.node_sets:
-            parts[name] = np.asarray(model.node_sets[name])
-    return parts
-
-
-@dataclass
-class Contacts:
-    count: np.ndarray  # (T,) tongue nodes on the wall
-    total_force_n: np.ndarray  # (T,) N
-    nodes: list  # per frame: node indices
-    force_n: list  # per frame: N per node
-
-
-@dataclass
-class Simulation:
-    """A simulation file, read back whole: times (s), positions (cm) of every node and by part, control
-    points, muscle forces (N) and lengths (cm), contacts, volume and the run's settings."""
-
-    time_s: np.ndarray
-    positions_cm: np.ndarray  # (T, N, 3)
-    rest_cm: np.ndarray | None  # (N, 3) the model's rest (the frame bones' motions are measured from)
-    velocities_cm_s: np.ndarray
-    parts: dict[str, np.ndarray]  # part -> node indices
-    control_points: dict[str, np.ndarray]  # name -> (T, 3) cm
-    volume_change: np.ndarray
-    inverted_bricks: np.ndarray
-    muscle_names: list[str]
-    muscle_force_n: np.ndarray | None
-    muscle_length_cm: np.ndarray | None
-    contacts: Contacts | None
-    attrs: dict
-
-    def part(self, name: str) -> np.ndarray:
-        """(T, n, 3) positions of one part (tongue, mandible, hyoid), cm."""
-        return self.positions_cm[:, self.parts[name]]
 
 
 def read(path: Path | str, allow_invalid: bool = False) -> Simulation:
