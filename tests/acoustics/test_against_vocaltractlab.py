@@ -14,7 +14,9 @@ from artic_cli.acoustics.transfer import Tract, transfer
 from artic_cli.acoustics.tube import Tube
 from artic_cli.config import load_config
 
-vtl = pytest.importorskip("vocaltractlab_cython")
+from conftest import need
+
+vtl = need("vocaltractlab_cython")
 
 
 def _vtl_formants(shape, **options) -> np.ndarray:

@@ -16,7 +16,7 @@ from artic_cli.acoustics.tube import from_pieces
 from artic_cli.cli.main import app
 from artic_cli.config import load_config
 
-from conftest import praat_formants_near
+from conftest import praat_formants_near, need
 
 VOWELS = {"a": ((9, 1), (8, 7)), "i": ((9, 8), (6, 1)), "u": ((5, 6), (3, 1.5), (6, 8), (2, 0.6))}
 
@@ -83,7 +83,7 @@ def test_a_closure_sliding_along_the_line_stays_silent(walls):
 
 @pytest.mark.parametrize("vowel", sorted(VOWELS))
 def test_praat_measures_our_transfer_function_formants_in_the_sound(vowel, tmp_path):
-    pytest.importorskip("parselmouth")
+    need("parselmouth")
     t = _csv(tmp_path, VOWELS[vowel])
     res = CliRunner().invoke(app, ["synthesize", "--tube", str(t), "--out", str(tmp_path / "v.wav"),
                                    "--duration", "0.6", "--f0", "115"])

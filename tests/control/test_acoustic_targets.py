@@ -13,7 +13,7 @@ from artic_cli.errors import ArticError, UnreachableTarget
 from artic_cli.stages.epmap import build_ep_maps
 from artic_cli.stages.solve import add_formants, load_context, simulator, solve_target
 
-from conftest import ROOT, praat_formants_near
+from conftest import ROOT, praat_formants_near, need
 
 
 def _acoustic(formants, tol=5.0, **extra):
@@ -79,14 +79,23 @@ def small_maps(tmp_path_factory, mesh_file):
     return tmp, cfg
 
 
-def test_a_simulated_vowel_is_found_again_and_refined_within_its_tolerance(small_maps, mesh_file):
+@pytest.fixture(scope="module")
+def found_vowel(small_maps, mesh_file):
+    """A vowel simulated off the maps' grid (GGp 2 N + HG 1.5 N, the config's lips, port closed), solved from
+    its F1 / F2 (2 %) and refined: (the answer, its file, the simulated vowel, the context)."""
     tmp, cfg = small_maps
     voicer = simulator(mesh_file, cfg, voiced=True)
-    made = voicer.voice({}, {"GGp": 2.0, "HG": 1.5}, (3.0, 1.0), 0.0)  # the config's lips, port closed
+    made = voicer.voice({}, {"GGp": 2.0, "HG": 1.5}, (3.0, 1.0), 0.0)
     target = _acoustic(made["formants_hz"][:2], tol=2.0, name="found")
     ctx = add_formants(load_context(tmp / "maps.h5", None, mesh_file), tmp / "maps.h5", mesh_file, cfg)
     doc, path, _ = solve_target(target, ctx, tmp / "found.yaml", voicer, refine=True, budget=6, config=cfg,
                                 mesh_sha256=voicer.mesh_sha256)
+    return doc, path, made, ctx
+
+
+def test_a_simulated_vowel_is_found_again_and_refined_within_its_tolerance(small_maps, mesh_file, found_vowel):
+    tmp, cfg = small_maps
+    doc, path, made, ctx = found_vowel
     assert doc["refined"]["converged"] and doc["refined"]["within_tolerance"]
     assert all(abs(e) <= 2.0 for e in doc["refined"]["errors_pct"][:2])
     af = doc["refined"]["area_function"]
@@ -169,22 +178,19 @@ def test_unreachable_formants_exit_3_with_the_nearest_and_write_it(small_maps, m
     assert "unreachable" in sol and sol["nearest"]["forces_n"] and len(sol["nearest"]["predicted_formants_hz"]) == 4
 
 
-def test_a_solved_vowel_sounds_with_its_formants(small_maps, tmp_path):
-    """The WAV of a refined solution (0.6 s, F0 falling 125 -> 100 Hz): Praat finds its F1 and F2."""
-    pytest.importorskip("parselmouth")
+def test_a_solved_vowel_sounds_with_its_formants(found_vowel, tmp_path):
+    """The WAV of a refined solution (0.6 s, F0 falling 125 -> 100 Hz): Praat finds the F1 and F2 the target
+    asked for (the simulated vowel's), within the tolerances the vowels are judged by (10 % / 7 %)."""
+    need("parselmouth")
     from artic_cli.stages.synthesize import synthesize_solution
 
-    tmp, _ = small_maps
-    sol = tmp / "found.yaml"  # written by the refinement test above (module order)
-    if not sol.is_file():
-        pytest.skip("needs the refined solution of test_a_simulated_vowel_is_found_again...")
+    _, sol, made, _ = found_vowel
     audio = synthesize_solution(sol, tmp_path / "v.wav", 0.6, None, ROOT / "configs" / "voice" / "f0_fall_125_100.csv")
     assert abs(len(audio.samples) / audio.sample_rate_hz - 0.6) < 0.01
-    ours = yaml.safe_load(sol.read_text())["refined"]["formants_hz"]
-    near, found = praat_formants_near(tmp_path / "v.wav", np.linspace(0.2, 0.4, 9), ours[:2])
+    asked = made["formants_hz"][:2]
+    near, found = praat_formants_near(tmp_path / "v.wav", np.linspace(0.2, 0.4, 9), asked)
     for k, tol in ((0, 0.10), (1, 0.07)):
-        nearest = near[k]
-        assert abs(nearest / ours[k] - 1) < tol, (k + 1, nearest, ours[k], found)
+        assert abs(near[k] / asked[k] - 1) < tol, (k + 1, near[k], asked[k], found)
 
 
 @pytest.mark.parametrize("body,needle", [
@@ -203,16 +209,12 @@ def test_a_solution_without_a_usable_area_function_is_refused(tmp_path, body, ne
     assert res.exit_code == 2 and needle in res.output and not (tmp_path / "v.wav").exists(), res.output
 
 
-def test_a_vowel_answer_is_drawn_without_the_maps(small_maps, tmp_path):
+def test_a_vowel_answer_is_drawn_without_the_maps(found_vowel, tmp_path):
     from typer.testing import CliRunner
 
     from artic_cli.cli.main import app
 
-    tmp, _ = small_maps
-    sol = tmp / "found.yaml"
-    if not sol.is_file():
-        pytest.skip("needs the refined solution of test_a_simulated_vowel_is_found_again...")
-    doc = yaml.safe_load(sol.read_text())
+    doc, sol, _, _ = found_vowel
     target = tmp_path / "found_target.yaml"
     target.write_text(yaml.safe_dump({"name": "found", "jaw": {"forces_n": {}},
                                       "acoustic": {"formants_hz": doc["acoustic"]["formants_hz"]}}))

@@ -15,7 +15,7 @@ from artic_cli.stages.epmap import build_ep_maps, load_ep_maps
 from artic_cli.errors import ArticError
 from artic_cli.experiments.paper import fig7
 
-from conftest import ROOT
+from conftest import ROOT, need
 
 
 def _config(tmp_path, name: str, **epmap) -> str:
@@ -190,7 +190,7 @@ def test_rest_map_rebuilt_from_scratch_equals_the_cached_one(small, mesh_file):
 
 
 def test_dask_local_cluster_gives_the_same_maps(small, mesh_file):
-    pytest.importorskip("dask.distributed")
+    need("dask.distributed")
     tmp, _, _ = small
     cfg = _config(tmp, "tiny", jaw_positions={"rest": {}}, typical_jaw="rest", muscles=["SL"], levels_n=[0.0, 1.0],
                   net_jaw_positions=[], pairs_tip=[], pairs_dorsum=[], groups=[])

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import yaml
 
-from artic_cli.control.dynamic import derive, table_iv
+from artic_cli.control.dynamic import table_iv
 from artic_cli.stages.dynamic import build_dynamic_map, load_dynamic_map
 from artic_cli.stages.epmap import build_ep_maps
 from artic_cli.control.solver import parse_target
@@ -83,12 +83,13 @@ def test_refine_reaches_a_tight_tolerance_the_maps_alone_miss(maps, mesh_file):
     tmp, cfg = maps
     sim = simulator(mesh_file, cfg)
     ctx = load_context(tmp / "maps.h5", tmp / "dynamic.h5")
+    missed = 0
     for forces in ({"SL": 3.7, "GGp": 2.2}, {"GGm": 2.0, "SG": 0.6}, {"SL": 1.3, "GGa": 3.5}):
         reached = sim.reach({"JO": 0.5}, forces)
         doc = solve(ctx, _target(reached[0, :2], reached[1, :2], tol=0.01), sim, verify=True, refine=True)
-        assert doc["refined"]["crucial_error_cm"] <= 0.01 < doc["verified"]["crucial_error_cm"] or \
-            doc["verified"]["crucial_error_cm"] <= 0.01
-        assert doc["refined"]["simulations"] <= 8
+        assert doc["refined"]["crucial_error_cm"] <= 0.01 and doc["refined"]["simulations"] <= 8
+        missed += doc["verified"]["crucial_error_cm"] > 0.01
+    assert missed >= 1  # the maps alone miss at least one of them: the refinement did the work
 
 
 def test_chosen_force_set_is_the_cheapest_candidate(maps):
@@ -109,20 +110,30 @@ def test_unreachable_target_names_the_nearest_point(maps):
         solve(ctx, _target([2.0, 3.0]))
 
 
-def test_table_iv_is_computed_from_the_maps(maps):
+def _kabsch_mean_error(p: np.ndarray, q: np.ndarray) -> float:
+    """Mean distance (cm) left by the least-squares rigid motion of points p onto q (n, 2), by the SVD (Kabsch),
+    a second method beside the dynamic map's closed-form angle."""
+    pc, qc = p.mean(axis=0), q.mean(axis=0)
+    u, _, vt = np.linalg.svd((p - pc).T @ (q - qc))
+    r = vt.T @ np.diag([1.0, np.sign(np.linalg.det(vt.T @ u.T))]) @ u.T
+    return float(np.mean(np.linalg.norm((p - pc) @ r.T + qc - q, axis=1)))
+
+
+def test_table_iv_is_the_best_rigid_carry_of_the_typical_map(maps):
+    """At each mapped jaw position Table IV's mean error is what the least-squares rigid motion of the typical
+    map's settled single-muscle EPs onto that position's leaves (Kabsch), tip and dorsum."""
     tmp, _ = maps
     ctx = load_context(tmp / "maps.h5", tmp / "dynamic.h5")
     dm = load_dynamic_map(tmp / "dynamic.h5", maps_path=tmp / "maps.h5")
     rows = {r["jaw"]: r for r in table_iv(dm)}
-    assert rows["JO_0.5"]["error_tip_cm"] == pytest.approx(0.0, abs=1e-9)
+    typ = ctx.maps.jaws[dm.typical]
     for jaw in ("rest", "JO_2.5", "JC_1.5"):
-        # recompute the mean error independently: derive the typical map at that jaw's height, compare vectors
-        # over the EPs settled in both maps (an unsettled EP is never used)
-        sim, typ = ctx.maps.jaws[jaw], ctx.maps.jaws[dm.typical]
-        derived = derive(ctx.maps, dm, float(sim.rest[2, 1]))
-        errs = [np.linalg.norm(derived.single[m].x[:, 0, :2] - sim.single[m].x[:, 0, :2], axis=1)[
-            typ.single[m].converged & sim.single[m].converged] for m in MUSCLES]
-        assert rows[jaw]["error_tip_cm"] == pytest.approx(float(np.mean(np.concatenate(errs))), rel=1e-6)
+        sim = ctx.maps.jaws[jaw]
+        for cp, key in ((0, "error_tip_cm"), (1, "error_dorsum_cm")):
+            ok = [typ.single[m].converged & sim.single[m].converged for m in MUSCLES]
+            p = np.concatenate([typ.single[m].x[k, cp, :2] for m, k in zip(MUSCLES, ok)])
+            q = np.concatenate([sim.single[m].x[k, cp, :2] for m, k in zip(MUSCLES, ok)])
+            assert rows[jaw][key] == pytest.approx(_kabsch_mean_error(p, q), rel=1e-6, abs=1e-9), (jaw, key)
         assert 0 < rows[jaw]["error_tip_cm"] < 0.15 and rows[jaw]["loo_tip_cm"] is not None
     assert rows["JO_2.5"]["position_cm"] < rows["rest"]["position_cm"] < rows["JC_1.5"]["position_cm"]
 

@@ -225,10 +225,11 @@ def test_the_blade_sides_reach_the_front_palate_at_4_n_or_less(art, rest):
 
 
 def test_k_closure_reports_the_blade_and_the_tip_reach(art, cfg):
+    """The report's k-closure rows count what the held-jaw runs put on the wall (SG's first contact force is
+    judged by the sweep above, not here: with one force level it could only be that level)."""
     rows = {r.name: r for r in k_closure(art, forces=(4.0,), hold=cfg.epmap.hold_jaw)}
     assert rows["blade nodes on the alveolar ridge"].ours >= 1, rows["blade nodes on the alveolar ridge"].note
     assert rows["tip on the lower incisors' lingual side"].ours == 1.0
-    assert rows["SG force at first dorsum-palate contact"].ours == 4.0
 
 
 def _ours(obj) -> bool:
