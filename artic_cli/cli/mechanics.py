@@ -41,7 +41,12 @@ def build_mesh_cmd(
 @app.command("simulate")
 @handle_errors
 def simulate_cmd(
-    schedule: Path = typer.Option(..., "--schedule", help="Load schedule (YAML): node sets, forces in N, onset/duration in ms."),
+    schedule: Optional[Path] = typer.Option(None, "--schedule", help="Load schedule (YAML): node sets, forces in N, "
+                                            "onset/duration in ms."),
+    solution: Optional[Path] = typer.Option(None, "--solution", help="Replay a solve-target answer as it was "
+                                            "verified (instead of --schedule) and report its crucial error."),
+    hold_jaw: Optional[bool] = typer.Option(None, "--hold-jaw/--free-jaw", help="With --solution: the mandible "
+                                            "held as the maps hold it, or free (default: as the answer records)."),
     duration: Optional[float] = typer.Option(None, "--duration", help="Simulated time in s (default: the schedule's duration_ms)."),
     dt: Optional[float] = typer.Option(None, "--dt", help="Time step in s (default: the config's dt_ms)."),
     mesh: Path = typer.Option(paths.MESH, "--mesh", help="Mesh artefact from build-mesh."),
@@ -56,6 +61,11 @@ def simulate_cmd(
 ):
     """Move the model under a schedule of muscle forces and loads; write trajectories."""
     from ..stages.simulate import simulate
+
+    if (schedule is None) == (solution is None):
+        raise ArticError("give --schedule FILE or --solution FILE (one of them)")
+    if solution is not None:
+        return _replay(solution, mesh, config, out, hold_jaw)
 
     args = (schedule, duration, dt, mesh, config, out, volume_constraint)
     r = with_progress("simulating", lambda update: simulate(*args, update, tongue_only=tongue_only, contact=contact))
@@ -75,6 +85,19 @@ def simulate_cmd(
         f"inverted bricks {int(t.inverted.max())}" + (f"; figure {plot}" if plot else "")
         + (f"; animation {animate}" if animate else ""), highlight=False)
     refuse_unphysical(r)
+
+
+def _replay(solution: Path, mesh: Path, config: Optional[Path], out: Optional[Path], hold_jaw: Optional[bool]):
+    from ..stages.solve import replay_solution
+
+    r = with_progress("simulating", lambda update: replay_solution(solution, mesh, config, out, hold_jaw, update))
+    c = r.conditions
+    where = "; ".join(f"{n} ({x:.4f}, {y:.4f})" for n, (x, y) in r.reached_cm.items())
+    how = f"jaw {c['jaw']}, {c['duration_ms']:g} ms from {c['start']}"
+    out_console.print(f"{solution} replayed ({how}): {where} cm" + (f"; written to {r.path}" if r.path else ""),
+                      highlight=False)
+    if r.crucial_error_cm is not None:
+        out_console.print(f"crucial error {r.crucial_error_cm:.4f} cm", highlight=False)
 
 
 def refuse_unphysical(r) -> None:

@@ -29,6 +29,9 @@ def solve_target_cmd(
                                                                    "targets."),
     config: Optional[Path] = typer.Option(None, "--config", help="Config for --verify / --refine and acoustic "
                                                                  "targets."),
+    hold_jaw: bool = typer.Option(False, "--hold-jaw", help="Check the answer with the mandible held at the jaw "
+                                  "position's rest, as the maps were made (default: the jaw free, as 'artic "
+                                  "simulate' and 'artic speak' run the forces)."),
     acoustic_maps: Path = typer.Option(paths.ACOUSTIC_MAPS, "--acoustic-maps",
                                        help="Formants of every EP from 'artic acoustic-map' (acoustic targets; "
                                             "computed from the maps' shapes when absent or for other lips)."),
@@ -38,7 +41,8 @@ def solve_target_cmd(
     from ..stages.solve import solve_files
 
     r = with_progress("targets", lambda update: solve_files(target, batch, maps, dynamic, mesh, config, acoustic_maps,
-                                                            out, verify, refine, budget, jobs, update), plain=True)
+                                                            out, verify, refine, budget, jobs, update,
+                                                            hold_jaw or None), plain=True)
     if r.rows is not None:
         bad = sum("unreachable" in row for row in r.rows)
         out_console.print(f"wrote {r.path}: {len(r.rows)} targets, {len(r.rows) - bad} solved, {bad} unreachable",

@@ -18,7 +18,8 @@ from pydantic import ValidationError
 from ..errors import ArticError
 from ..validation import Strict, describe, parse
 from .body import *  # noqa: F401,F403  (every section's schema, importable from artic_cli.config)
-from .body import Contact, Cuboid, EPMapSpec, Jaw, Materials, MuscleFunctionSpec, Muscles, Simulation, Speaker
+from .body import (Contact, Cuboid, EPMapSpec, Jaw, Materials, MuscleFunctionSpec, Muscles, Simulation, SolverSpec,
+                   Speaker)
 from .sound import *  # noqa: F401,F403
 from .sound import Acoustics, Speech, VocalTract
 
@@ -35,6 +36,7 @@ class Config(Strict):
     contact: Contact = Contact()
     cuboid: Cuboid = Cuboid()
     epmap: EPMapSpec = EPMapSpec()
+    solver: SolverSpec = SolverSpec()  # how an answer is verified and refined
     muscle_function: MuscleFunctionSpec = MuscleFunctionSpec()
     acoustics: Acoustics = Acoustics()
     vocal_tract: VocalTract | None = None  # the speaker's tract (required by 'artic vocal-tract')

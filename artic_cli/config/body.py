@@ -213,6 +213,15 @@ JAW_POSITIONS = {"rest": {}, "JO_0.5": {"JO": 0.5}, "JO_1.2": {"JO": 1.2}, "JO_2
                  "JO_6": {"JO": 6.0}, "JC_0.5": {"JC": 0.5}, "JC_1.5": {"JC": 1.5}, "JC_3": {"JC": 3.0}}
 
 
+class SolverSpec(Strict):
+    """How an answer is checked: its forces (jaw and tongue) switched on together from the rest posture and
+    held ``verify_ms``, the jaw free, as ``artic simulate`` and ``artic speak`` move them;
+    ``verify_hold_jaw``: the maps' condition instead (the jaw position's rest, its mandible held)."""
+
+    verify_ms: Annotated[float, Field(gt=0, le=5000, allow_inf_nan=False)] = 400.0
+    verify_hold_jaw: bool = False
+
+
 class EPMapSpec(Strict):
     """What ``artic ep-map`` computes (the paper's section IV.B)."""
 

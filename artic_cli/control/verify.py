@@ -18,41 +18,68 @@ import numpy as np
 from ..config import Config
 from ..geometry.mesh import Mesh
 from ..geometry.wall import WallSurface
+from .. import units
 from ..io.fingerprint import code_hash, digest, sections_hash
+from ..mechanics.replay import held_forces, run_schedule
 from ..mechanics.model import ARTICULATOR_SECTIONS, CONTROL_POINTS
 from .epmap import JawMaps, add_forces, canonical
-from .equilibrium import equilibrium_point, equilibrium_state, worker_model, worker_rest
+from .equilibrium import equilibrium_state, watch_nodes, worker_model, worker_rest
 from .solver import Candidate
 
 MAX_STEP_N = 1.5  # largest change of one force per refinement step
 
 
 class Simulator:
-    """The articulator of a mesh and config, with each jaw position's rest computed once (per process)."""
+    """The articulator of a mesh and config, checking force sets as ``artic simulate`` runs them: every force
+    (jaw and tongue) switched on together from the rest posture and held ``solver.verify_ms`` with the jaw
+    free.  ``hold_jaw`` (default ``solver.verify_hold_jaw``): the maps' condition instead, the forces held from
+    the jaw position's rest with its mandible held.  The model and its rests are built once per process."""
 
-    def __init__(self, cfg: Config, mesh: Mesh, wall: WallSurface, mesh_sha256: str):
+    def __init__(self, cfg: Config, mesh: Mesh, wall: WallSurface, mesh_sha256: str, hold_jaw: bool | None = None):
         self.cfg = cfg
         self.mesh, self.wall, self.mesh_sha256 = mesh, wall, mesh_sha256
+        self.hold_jaw = cfg.solver.verify_hold_jaw if hold_jaw is None else bool(hold_jaw)
         self.key = digest({"sections": sections_hash(cfg, ARTICULATOR_SECTIONS), "mesh": mesh_sha256,
                            "code": code_hash("artic_cli.control.equilibrium")})
         self.cfg_json = json.dumps(cfg.model_dump(mode="json"))
 
+    def conditions(self) -> dict:
+        """How this simulator checks an answer (what a solution file records, and what replays it)."""
+        if self.hold_jaw:
+            spec = self.cfg.epmap
+            return {"jaw": "held", "start": "the jaw position's rest", "duration_ms": spec.duration_ms,
+                    "extend_ms": spec.extend_ms, "dt_ms": self.cfg.simulation.dt_ms,
+                    "config_sections_sha256": sections_hash(self.cfg, (*ARTICULATOR_SECTIONS, "epmap")),
+                    "mesh_sha256": self.mesh_sha256}
+        return {"jaw": "free", "start": "the rest posture", "duration_ms": self.cfg.solver.verify_ms,
+                "dt_ms": self.cfg.simulation.dt_ms, "forces": "every force on at 0 ms, held (artic simulate)",
+                "config_sections_sha256": sections_hash(self.cfg, ARTICULATOR_SECTIONS),
+                "mesh_sha256": self.mesh_sha256}
+
+    def _model(self):
+        return worker_model(self.key, self.cfg_json, self.mesh, self.wall)
+
     def reach(self, jaw_forces: dict[str, float], forces: dict[str, float]) -> np.ndarray:
-        """(3, 3) tip, dorsum, jaw (cm) after holding the forces from the jaw position's rest."""
-        model = worker_model(self.key, self.cfg_json, self.mesh, self.wall)
-        start = worker_rest(self.key, canonical(jaw_forces), self.cfg_json, self.mesh, self.wall)
-        return equilibrium_point(model, start, add_forces(dict(jaw_forces), forces), self.cfg.epmap).x
+        """(3, 3) tip, dorsum, jaw (cm) where the forces take the articulators."""
+        return self.shape(jaw_forces, forces)[1]
 
     def shape(self, jaw_forces: dict[str, float], forces: dict[str, float]) -> tuple[np.ndarray, np.ndarray]:
-        """The whole shape (N, 3) and the control points (3, 3) after holding the forces, as :meth:`reach`;
-        also the model's rest and the mandible's nodes (what a vocal tract needs)."""
-        model = worker_model(self.key, self.cfg_json, self.mesh, self.wall)
-        start = worker_rest(self.key, canonical(jaw_forces), self.cfg_json, self.mesh, self.wall)
-        state, ep = equilibrium_state(model, start, add_forces(dict(jaw_forces), forces), self.cfg.epmap)
-        return state.x, ep.x
+        """The whole shape (N, 3) and the control points (3, 3) where the forces take the articulators."""
+        model = self._model()
+        total = add_forces(dict(jaw_forces), forces)
+        if self.hold_jaw:
+            start = worker_rest(self.key, canonical(jaw_forces), self.cfg_json, self.mesh, self.wall)
+            state, ep = equilibrium_state(model, start, total, self.cfg.epmap)
+            return state.x, ep.x
+        rest = worker_rest(self.key, canonical({}), self.cfg_json, self.mesh, self.wall)  # the settled rest
+        duration_ms = self.cfg.solver.verify_ms
+        traj = run_schedule(model, held_forces(total, duration_ms, self.cfg.muscles.max_force_n),
+                            units.ms_to_s(duration_ms), start=rest)
+        x = traj.x[-1]
+        return x, x[watch_nodes(model)].copy()
 
     def model_rest(self) -> tuple[np.ndarray, np.ndarray]:
-        model = worker_model(self.key, self.cfg_json, self.mesh, self.wall)
+        model = self._model()
         return model.rest, np.asarray(model.node_sets["mandible"])
 
 

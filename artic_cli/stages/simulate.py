@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Callable
 
 import numpy as np
+import yaml
 
 from .. import units
 from ..config import Config, load_config
@@ -18,10 +19,10 @@ from ..errors import ArticError
 from ..geometry.wall import WallSurface
 from ..io.fingerprint import digest
 from ..io.store import Provenance, atomic_h5, open_artifact
-from ..mechanics.loads import load_program
-from ..mechanics.model import ARTICULATOR_SECTIONS, Model, build_articulator, build_model, rest_state
+from ..mechanics.model import ARTICULATOR_SECTIONS, Model, build_articulator, build_model
 from ..mechanics.record import Contacts, Simulation, node_parts
-from ..mechanics.simulate import Trajectory, problems, run, settle
+from ..mechanics.replay import run_schedule
+from ..mechanics.simulate import Trajectory, problems
 from ..schedule import Schedule, load_schedule
 from ..validation import check_number
 from . import mesh as mesh_stage
@@ -54,11 +55,7 @@ def run_simulation(model: Model, schedule: Schedule, duration_s: float, dt_s: fl
                    record_every: int = 1, source: str = "schedule",
                    progress: Callable[[int, int], None] | None = None) -> Trajectory:
     """From the rest posture (settled under gravity for the articulator), under ``schedule``."""
-    program = load_program(model, schedule, source)
-    start = rest_state(model) if tongue_only else settle(model)
-    traj, _ = run(model, start, program.control_at, duration_s, dt_s, record_every=record_every,
-                  progress=progress, keep_partial=True)
-    return traj
+    return run_schedule(model, schedule, duration_s, dt_s, tongue_only, record_every, source, progress)
 
 
 MIN_DT_S = 1e-6  # a step below a microsecond is a typo, not a simulation
@@ -74,16 +71,21 @@ class SimResult:
     problems: list[str] = field(default_factory=list)  # why the result is not physical (its file is marked invalid)
 
 
-def simulate(schedule: Path | str, duration: float | None = None, dt: float | None = None,
+def simulate(schedule: Path | str | Schedule, duration: float | None = None, dt: float | None = None,
              mesh: Path | str = paths.MESH, config: Path | str | None = None, out: Path | str | None = None,
              volume_constraint: bool | None = None, progress: Callable[[int, int], None] | None = None,
              tongue_only: bool = False, contact: bool | None = None, force: bool = False) -> SimResult:
-    """Run the model under a schedule from its rest posture; write ``out`` (HDF5).  A file that already holds
-    this recipe (same mesh content, config sections, schedule, options and code) is left alone."""
+    """Run the model under a schedule (a file, or one made in Python) from its rest posture; write ``out``
+    (HDF5).  A file that already holds this recipe (same mesh content, config sections, schedule, options and
+    code) is left alone."""
     check_number("--duration", duration, gt=0, le=MAX_DURATION_S, unit="s")
     check_number("--dt", dt, ge=MIN_DT_S, unit="s")
     cfg = load_config(config)
-    sched = load_schedule(schedule, cfg.muscles.max_force_n)
+    made = isinstance(schedule, Schedule)
+    sched = schedule if made else load_schedule(schedule, cfg.muscles.max_force_n)
+    text = yaml.safe_dump(sched.model_dump(mode="json"), sort_keys=False) if made else Path(schedule).read_text()
+    if made and out is None:
+        raise ArticError("a schedule made in Python needs an output path (out=...)")
     if duration is None:
         if sched.duration_ms is None:
             raise ArticError(f"{schedule}: no duration; give --duration S or 'duration_ms' in the schedule")
@@ -109,7 +111,7 @@ def simulate(schedule: Path | str, duration: float | None = None, dt: float | No
     traj = run_simulation(model, sched, duration, h, tongue_only, cfg.simulation.record_every, str(schedule),
                           progress)
     bad = problems(traj, model.volume_constraint)
-    write(out, traj, model, prov, extra={"duration_s": duration, "schedule_yaml": Path(schedule).read_text(),
+    write(out, traj, model, prov, extra={"duration_s": duration, "schedule_yaml": text,
                                          "tongue_only": tongue_only, "valid": not bad,
                                          "invalid_reason": "; ".join(bad)})
     return SimResult(out, traj, model, m.wall, float(np.nanmax(np.abs(traj.volume_change))), problems=bad)

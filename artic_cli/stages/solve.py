@@ -5,6 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 from ..config import load_config
 from ..control.acoustic_map import EPFormants
 from ..control.solver import TargetSpec
@@ -25,7 +27,7 @@ from . import mesh as mesh_stage
 from . import paths
 from .base import Stage, up_to_date
 
-SPATIAL_SECTIONS = (*ARTICULATOR_SECTIONS, "epmap")
+SPATIAL_SECTIONS = (*ARTICULATOR_SECTIONS, "epmap", "solver")
 STAGE = Stage(name="solve", module=__name__, sections=(*SPATIAL_SECTIONS, "vocal_tract", "acoustics"),
               reads=("epmaps", "dynamic"),
               kind="solution", hint="rerun 'artic solve-target TARGET.yaml'")
@@ -65,10 +67,13 @@ def add_formants(ctx: Context, maps: Path | str, mesh: Path | str, config: Path 
     return ctx
 
 
-def simulator(mesh: Path | str, config: Path | str | None = None, voiced: bool = False) -> Simulator | Voicer:
+def simulator(mesh: Path | str, config: Path | str | None = None, voiced: bool = False,
+              hold_jaw: bool | None = None) -> Simulator | Voicer:
+    """What checks answers: the forces run as ``artic simulate`` runs them (``hold_jaw``: the maps' held jaw;
+    None: the config's ``solver.verify_hold_jaw``); ``voiced``: with the tract's formants too."""
     cfg = load_config(config)
     m = mesh_stage.read(mesh, cfg)
-    sim = Simulator(STAGE.view(cfg).full, m.mesh, m.wall, m.content_sha256)
+    sim = Simulator(STAGE.view(cfg).full, m.mesh, m.wall, m.content_sha256, hold_jaw)
     return Voicer(sim, cfg) if voiced else sim
 
 
@@ -100,7 +105,10 @@ def solve_target(target: Path | str | TargetSpec, ctx: Context, out: Path | str 
         cfg = load_config(config)
         inputs["acoustic_maps"] = ctx.acoustic_sha256
         sections = STAGE.sections
-    prov = STAGE.provenance(cfg, inputs=inputs, params={"verify": verify, "refine": refine, "budget": budget},
+    checked = getattr(sim, "sim", sim)  # a Voicer's simulator
+    held = bool(checked.hold_jaw) if (verify or refine) and checked is not None else None
+    prov = STAGE.provenance(cfg, inputs=inputs, params={"verify": verify, "refine": refine, "budget": budget,
+                                                        "hold_jaw": held},
                             sections=sections)
     if up_to_date(path, prov):
         doc = read(path)
@@ -113,6 +121,8 @@ def solve_target(target: Path | str | TargetSpec, ctx: Context, out: Path | str 
         return doc, path, True
     try:
         doc = solve(ctx, t, sim, verify, refine, budget)
+        if held is not None:  # how the answer was checked: what 'artic simulate --solution' replays
+            doc["verification"] = checked.conditions()
     except UnreachableTarget as err:  # the answer is written too (make and scripts can report it)
         near = {key: getattr(err, attr) for attr, key in _NEAREST.items() if getattr(err, attr, None) is not None}
         write(path, {"target": t.name, "unreachable": str(err), **near, **getattr(err, "answer", {})}, prov)
@@ -192,7 +202,7 @@ def solve_files(target: Path | str | None = None, batch: Path | str | None = Non
                 dynamic: Path | str = paths.DYNAMIC, mesh: Path | str = paths.MESH, config: Path | str | None = None,
                 acoustic_maps: Path | str = paths.ACOUSTIC_MAPS, out: Path | str | None = None,
                 verify: bool = False, refine: bool = False, budget: int = 8, jobs: int = 2,
-                progress=None) -> Solved:
+                progress=None, hold_jaw: bool | None = None) -> Solved:
     """A target file, or every row of a batch CSV (written to ``out``, default data/solutions/BATCH.csv, with
     ``verify``/``refine`` on ``jobs`` workers), solved on the maps; what a target needs is loaded once: the
     dynamic map for places, the formants of every EP for acoustic targets, the simulator for checks."""
@@ -206,9 +216,10 @@ def solve_files(target: Path | str | None = None, batch: Path | str | None = Non
     ctx = load_context(maps, dynamic if spatial else None, mesh if (verify or refine or acoustic) else None)
     if acoustic:
         add_formants(ctx, maps, mesh, config, acoustic_maps)
-    sim = simulator(mesh, config, voiced=acoustic) if (verify or refine) else None
+    sim = simulator(mesh, config, voiced=acoustic, hold_jaw=hold_jaw) if (verify or refine) else None
     if batch is not None:
-        args = None if sim is None else (sim.cfg, sim.mesh, sim.wall, sim.mesh_sha256)
+        base = getattr(sim, "sim", sim)  # a Voicer's simulator
+        args = None if base is None else (base.cfg, base.mesh, base.wall, base.mesh_sha256, base.hold_jaw)
         rows = solve_rows(ctx, targets, jobs, args, verify, refine, budget, progress)
         path = Path(out) if out is not None else paths.SOLUTIONS / f"{Path(batch).stem}.csv"
         write_text_atomic(path, batch_csv(rows))
@@ -216,3 +227,51 @@ def solve_files(target: Path | str | None = None, batch: Path | str | None = Non
     doc, path, fresh = solve_target(targets[0], ctx, out, sim, verify, refine, budget, config,
                                     "" if sim is None else sim.mesh_sha256)
     return Solved(target=targets[0], doc=doc, path=path, up_to_date=fresh)
+
+
+@dataclass
+class Replay:
+    """An answer run again as it was verified: where its forces take the control points (cm), what the
+    solution recorded, and the crucial point's error (cm; None for a formant target)."""
+
+    reached_cm: dict[str, list[float]]
+    recorded_cm: dict[str, list[float]]
+    crucial_error_cm: float | None
+    conditions: dict
+    path: Path | None = None  # the simulation file (a free-jaw replay)
+
+
+def replay_solution(solution: Path | str, mesh: Path | str = paths.MESH, config: Path | str | None = None,
+                    out: Path | str | None = None, hold_jaw: bool | None = None, progress=None) -> Replay:
+    """Run a solution's forces as its verification ran them (``hold_jaw`` overrides the recorded condition):
+    the jaw free, every force on at 0 ms from the rest posture, through ``artic simulate`` (a simulation file,
+    ``out``); or the jaw held, as the maps hold it."""
+    from ..mechanics.replay import held_forces
+    from ..speech.plan import solution_forces
+    from . import simulate as sim_stage
+
+    doc = read(solution)
+    cond = doc.get("verification")
+    if not cond:
+        raise ArticError(f"{solution} records no verification; solve the target with --verify or --refine")
+    forces, _, which = solution_forces(doc)
+    held = cond["jaw"] == "held" if hold_jaw is None else bool(hold_jaw)
+    recorded = (doc.get("refined") if which == "refined" else doc.get("verified")) or {}
+    path = None
+    if held:
+        reached = simulator(mesh, config, hold_jaw=True).reach(dict(doc["jaw"]["forces_n"]), {
+            k: v for k, v in forces.items() if k not in doc["jaw"]["forces_n"]})
+    else:
+        cfg = load_config(config)
+        path = Path(out) if out is not None else paths.SIMS / f"{Path(solution).stem}.h5"
+        r = sim_stage.simulate(held_forces(forces, cond["duration_ms"], cfg.muscles.max_force_n),
+                               cond["duration_ms"] / 1e3, mesh=mesh, config=config, out=path, progress=progress)
+        cps = sim_stage.read(r.path).control_points
+        reached = np.array([cps[n][-1] for n in ("tip", "dorsum", "jaw")])
+    got = {n: [round(float(v), 4) for v in reached[k, :2]] for k, n in enumerate(("tip", "dorsum", "jaw"))}
+    error = None
+    if "crucial" in doc:
+        error = float(np.linalg.norm(reached[("tip", "dorsum").index(doc["crucial"]["point"]), :2]
+                                     - np.asarray(doc["crucial"]["at_cm"], float)))
+    return Replay(reached_cm=got, recorded_cm=recorded.get("reached_cm", {}), crucial_error_cm=error,
+                  conditions=dict(cond, jaw="held" if held else "free"), path=path)

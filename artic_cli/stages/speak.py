@@ -35,7 +35,7 @@ from . import solve as solve_stage
 from .base import Stage, up_to_date
 
 STAGE = Stage(name="utterances", module=__name__,
-              sections=(*ARTICULATOR_SECTIONS, "epmap", "vocal_tract", "acoustics", "speech"),
+              sections=(*ARTICULATOR_SECTIONS, "epmap", "solver", "vocal_tract", "acoustics", "speech"),
               reads=("mesh", "epmaps", "acousticmaps"), kind="utterance", hint="rerun 'artic speak UTTERANCE.yaml'")
 
 

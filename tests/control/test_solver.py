@@ -198,3 +198,65 @@ def test_unreachable_exits_3_and_maps_from_another_mesh_exit_2(maps, tmp_path, m
     res = artic("solve-target", f, "--maps", tmp / "maps.h5", "--dynamic", tmp / "dynamic.h5", "--verify",
                 "--mesh", other)
     assert res.returncode == 2 and "another mesh" in res.stderr
+
+
+SEVEN = ["GGp", "GGm", "GGa", "HG", "SG", "SL", "IL"]
+
+
+def _answer_holds(args):
+    """A force set run through `artic simulate` (every force on at 0 ms, 400 ms from rest, the jaw free); its
+    tip the crucial target, its dorsum an indecisive one; solved with --verify --refine; an answer with exit 0
+    replayed through `artic simulate --solution`.  Returns (exit status, replayed crucial error or None,
+    replayed minus recorded positions, cm)."""
+    from artic_cli.mechanics.replay import held_forces
+    from artic_cli.stages.simulate import read as read_sim
+    from artic_cli.stages.simulate import simulate
+    from artic_cli.stages.solve import replay_solution
+
+    from conftest import run_cli
+
+    k, mesh_file, cfg, tmp, jaw, forces = args
+    work = tmp / f"holds_{k}"
+    work.mkdir(exist_ok=True)
+    made = simulate(held_forces({**jaw, **forces}, 400.0), 0.4, mesh=mesh_file, config=cfg, out=work / "made.h5")
+    cps = read_sim(made.path).control_points
+    target = work / "t.yaml"
+    target.write_text(yaml.safe_dump({"name": f"set{k}", "jaw": {"forces_n": jaw},
+                                      "crucial": {"point": "tip", "at_cm": cps["tip"][-1, :2].tolist(),
+                                                  "tolerance_cm": 0.05},
+                                      "indecisive": [{"point": "dorsum", "at_cm": cps["dorsum"][-1, :2].tolist()}]}))
+    res = run_cli("solve-target", target, "--maps", tmp / "maps.h5", "--dynamic", tmp / "dynamic.h5", "--mesh",
+                  mesh_file, "--config", cfg, "--verify", "--refine", "--out", work / "sol.yaml")
+    if res.exit_code != 0:
+        sol = yaml.safe_load((work / "sol.yaml").read_text())
+        return res.exit_code, None, None, "nearest_point_cm" in sol or "refined" in sol or "nearest" in sol
+    r = replay_solution(work / "sol.yaml", mesh_file, cfg, work / "check.h5")
+    drift = max(abs(a - b) for n in ("tip", "dorsum") for a, b in zip(r.reached_cm[n], r.recorded_cm[n]))
+    return 0, r.crucial_error_cm, drift, True
+
+
+def test_answers_hold_where_the_user_runs_them(maps, mesh_file):
+    """34 random force sets (every pair of the seven tongue muscles and five triples at JO 0.5 N, eight pairs at
+    JO 2.5 N; 0.3-3 N each): every answer solved with exit 0 reaches its tip target within the 0.05-cm
+    tolerance when `artic simulate --solution` runs it (the same conditions it was verified in, reproduced
+    within 0.001 cm), and every other exits 3 with its nearest answer written."""
+    from itertools import combinations
+
+    from joblib import Parallel, delayed
+
+    tmp, cfg = maps
+    rng = np.random.default_rng(43)
+    draw = lambda names: {m: float(rng.uniform(0.3, 3.0)) for m in names}  # noqa: E731
+    sets = [({"JO": 0.5}, draw(p)) for p in combinations(SEVEN, 2)]
+    sets += [({"JO": 0.5}, draw(rng.choice(SEVEN, 3, replace=False))) for _ in range(5)]
+    sets += [({"JO": 2.5}, draw(rng.choice(SEVEN, 2, replace=False))) for _ in range(8)]
+    res = Parallel(n_jobs=2)(delayed(_answer_holds)((k, mesh_file, cfg, tmp, jaw, f))
+                             for k, (jaw, f) in enumerate(sets))
+    solved = [r for r in res if r[0] == 0]
+    errors = [r[1] for r in solved]
+    print(f"\nanswers replayed by artic simulate: {len(solved)} of {len(sets)} solved; crucial error median "
+          f"{statistics.median(errors):.4f}, max {max(errors):.4f} cm; replay vs record max "
+          f"{max(r[2] for r in solved):.5f} cm")
+    assert all(r[0] in (0, 3) and r[3] for r in res), [r for r in res if r[0] not in (0, 3) or not r[3]]
+    assert len(solved) >= len(sets) // 2
+    assert max(errors) <= 0.05 and max(r[2] for r in solved) <= 0.001
