@@ -182,12 +182,17 @@ def _refine_acoustic(jm, target: TargetSpec, cands: list[Candidate], formants, v
         return hz_to_bark(formants[f"{family}/{name}"][..., :2])
 
     left, best, tried = budget - 1, None, []
+    # a candidate that starts outside the tolerance gets a share of the budget and then the next one its turn
+    # (the maps can mislead about a cell: they hold the jaw, the answer is checked with it free); the first,
+    # if its simulation already lies within the tolerance, the whole budget to bring it to the aim
+    share = max(3, budget // 2 - 1)
     for k, cand in enumerate(cands[:REFINE_TRIES]):
         if k > 0 and left < 2:
             break
         free = free_forces(cand)
+        turn = left if k == 0 and within(target, first["formants_hz"]) else min(left, share)
         r = broyden(measure, map_jacobian(jm, cand, free, feature), cand.forces, free, goal,
-                    lambda e, v: within(target, v["formants_hz"], AIM), left,
+                    lambda e, v: within(target, v["formants_hz"], AIM), turn,
                     first=(measure(cand.forces) if k > 0 else (hz_to_bark(np.asarray(first["formants_hz"][:2])), first)),
                     upper=top_force(jm))
         left -= r.simulations + (1 if k > 0 else 0)
@@ -229,14 +234,17 @@ def solve(ctx: Context, target: TargetSpec, simulator=None, verify: bool = False
                                           "dorsum": [_num(v) for v in reached[1, :2]]},
                            "crucial_error_cm": _num(err), "simulations": 1}
         if refine:
-            # correct the cheapest candidate; if it cannot get there, the next ones, within the budget
+            # correct the cheapest candidate; if it cannot get there in its share of the budget, the next
+            # ones: a cell the maps mislead about (the answer is checked with the jaw free, the maps held it)
+            # would otherwise spend every simulation creeping
             left, best, tried = budget - 1, None, []
+            share = max(3, budget // 2 - 1)
             for k, cand in enumerate(cands[:REFINE_TRIES]):
                 first = reached if k == 0 else None
-                if k > 0 and left < 2:
+                if k > 0 and left < 1:  # one simulation still tells whether a candidate lands within tolerance
                     break
                 r = do_refine(simulator, jm, jaw_forces, cand, target.crucial.point, goal,
-                              target.crucial.tolerance_cm, budget=left, first=first)
+                              target.crucial.tolerance_cm, budget=min(left, share), first=first)
                 left -= r.simulations
                 tried.append(f"{cand.family} {cand.name}")
                 if best is None or r.error < best[0].error:
