@@ -88,7 +88,7 @@ def simulate_cmd(
 
 
 def _replay(solution: Path, mesh: Path, config: Optional[Path], out: Optional[Path], hold_jaw: Optional[bool]):
-    from ..stages.solve import replay_solution
+    from ..stages.solve_runs import replay_solution
 
     r = with_progress("simulating", lambda update: replay_solution(solution, mesh, config, out, hold_jaw, update))
     c = r.conditions

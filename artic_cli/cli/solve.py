@@ -38,7 +38,7 @@ def solve_target_cmd(
 ):
     """Muscle forces that put the crucial feature (a place, or formants) on its target and approach the others
     (section V; formant targets go beyond the paper)."""
-    from ..stages.solve import solve_files
+    from ..stages.solve_runs import solve_files
 
     r = with_progress("targets", lambda update: solve_files(target, batch, maps, dynamic, mesh, config, acoustic_maps,
                                                             out, verify, refine, budget, jobs, update,

@@ -1,7 +1,7 @@
 """Stage ``utterances``: a sequence of targets in time -> muscle forces in time -> movement -> tract -> sound.
 
 Each segment's target is solved once (``solve-target --refine``; cached by content under the solutions folder,
-:func:`artic_cli.stages.solve.solve_batch`); :mod:`artic_cli.speech` plans and speaks it.  Outputs: the WAV, a
+:func:`artic_cli.stages.solve_runs.solve_batch`); :mod:`artic_cli.speech` plans and speaks it.  Outputs: the WAV, a
 Praat TextGrid (one interval per segment) and ``NAME.h5`` (forces, control points, area functions, formant
 tracks, the noise source), each written atomically; the HDF5 file is the stage's freshness record and is
 written last.
@@ -31,7 +31,7 @@ from ..speech.utterance import Utterance, check_forces, load_utterance
 from . import mesh as mesh_stage
 from . import paths
 from . import simulate as sim_stage
-from . import solve as solve_stage
+from . import solve_runs
 from .base import Stage, up_to_date
 
 STAGE = Stage(name="utterances", module=__name__,
@@ -193,7 +193,7 @@ def speak(utterance: Path | str, out: Path | str | None = None, maps: Path | str
         return SpeakResult(files, None, up_to_date=True)
     model = sim_stage.build(cfg, m.mesh, m.wall)
     check_forces(u, list(model.drivable()), str(utterance))
-    solve = partial(solve_stage.solve_batch, maps=maps, mesh=mesh, acoustic_maps=acoustic_maps, config=config,
+    solve = partial(solve_runs.solve_batch, maps=maps, mesh=mesh, acoustic_maps=acoustic_maps, config=config,
                     folder=folder, budget=budget, jobs=jobs,
                     dynamic=dynamic if dynamic is not None and needs_dynamic(targets, cfg) else None)
     p = plan(u, STAGE.view(cfg), targets, solve, accept_nearest, say)

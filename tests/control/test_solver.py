@@ -211,7 +211,7 @@ def _answer_holds(args):
     from artic_cli.mechanics.replay import held_forces
     from artic_cli.stages.simulate import read as read_sim
     from artic_cli.stages.simulate import simulate
-    from artic_cli.stages.solve import replay_solution
+    from artic_cli.stages.solve_runs import replay_solution
 
     from conftest import run_cli
 
