@@ -76,4 +76,4 @@ bench: setup $(OUT)/epmaps.h5 $(OUT)/dynamic.h5
 clean:
 	rm -rf $(OUT)/*.h5 $(OUT)/*.json $(OUT)/sims $(OUT)/experiments $(OUT)/solutions $(OUT)/cache $(OUT)/.stamps \
 	  $(OUT)/tracts $(OUT)/acoustics $(OUT)/audio $(OUT)/vowels $(OUT)/utterances \
-	  $(OUT)/.config $(OUT)/.paper_run $(PIPELINE_MK) $(REPORT)/*.png $(REPORT)/*.gif $(REPORT)/paper.md
+	  $(OUT)/.config $(OUT)/.paper_run $(PIPELINE_MK) $(REPORT)/*.png $(REPORT)/*.gif $(REPORT)/paper.md $(REPORT)/paper.html

@@ -95,6 +95,62 @@ def praat_f0(wav, times) -> np.ndarray:
     return np.array([pitch.get_value_at_time(float(t)) for t in times], dtype=float)
 
 
+CHROMIUM_FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+                  "--disable-background-networking", "--disable-component-update", "--disable-sync")
+_CHECKER = """<script>
+window.addEventListener("load", function () {
+  var out = {images: [], audio: []};
+  Array.prototype.forEach.call(document.images, function (im) { out.images.push([im.getAttribute("src"),
+                                                                                im.naturalWidth]); });
+  var list = document.getElementsByTagName("audio"), left = list.length;
+  function done() { var pre = document.createElement("pre"); pre.id = "artic-check";
+                    pre.textContent = JSON.stringify(out); document.body.appendChild(pre); }
+  if (!left) { done(); return; }
+  Array.prototype.forEach.call(list, function (a) {
+    function report() { out.audio.push([a.getAttribute("src"), isFinite(a.duration) ? a.duration : -1,
+                                        a.error ? a.error.code : 0]); if (--left === 0) { done(); } }
+    if (a.readyState >= 1) { report(); } else { a.addEventListener("loadedmetadata", report, {once: true});
+                                                a.addEventListener("error", report, {once: true}); a.load(); }
+  });
+});
+</script>"""
+
+
+def chromium() -> str:
+    """Debian's chromium (``.ci/run`` installs it); without it the test skips, and fails under CI."""
+    import shutil
+
+    exe = shutil.which("chromium") or shutil.which("chromium-browser")
+    if exe is None:
+        if IN_CI:
+            pytest.fail("chromium is not installed; .ci/run installs Debian's chromium", pytrace=False)
+        pytest.skip("chromium is not installed (apt-get install chromium)")
+    return exe
+
+
+def browser_check(page: Path, tmp: Path, screenshot: Path) -> dict:
+    """Open ``page`` in headless Chromium from the file system: a screenshot of its top, and what the browser
+    made of it: every image's natural width and every audio element's duration (s) and error code."""
+    import json
+    import re
+    import subprocess
+
+    exe = chromium()
+    subprocess.run([exe, *CHROMIUM_FLAGS, f"--user-data-dir={tmp / 'shot'}", "--window-size=1280,1800",
+                    f"--screenshot={screenshot}", page.resolve().as_uri()], capture_output=True, timeout=120)
+    probe = page.with_name(f".{page.stem}-check.html")
+    probe.write_text(page.read_text().replace("</body>", _CHECKER + "</body>"))
+    try:
+        res = subprocess.run([exe, *CHROMIUM_FLAGS, f"--user-data-dir={tmp / 'dom'}",
+                              "--autoplay-policy=no-user-gesture-required", "--virtual-time-budget=30000",
+                              "--dump-dom", probe.resolve().as_uri()], capture_output=True, text=True, timeout=120)
+    finally:
+        probe.unlink()
+    found = re.search(r'<pre id="artic-check">(.*?)</pre>', res.stdout, re.S)
+    assert found, res.stderr[-2000:]
+    return json.loads(found.group(1).replace("&quot;", '"'))
+
+
 def report_rows(path) -> list[list[str]]:
     """A report's rows (reports/paper.md's tables): item, paper, ours, verdict."""
     rows = []

@@ -37,6 +37,8 @@ def speak_cmd(
     plot: Optional[Path] = typer.Option(None, "--plot", help="Spectrogram with formant tracks, segments and the "
                                                              "tip/dorsum/jaw heights (PNG)."),
     animate: Optional[Path] = typer.Option(None, "--animate", help="The midsagittal view moving (GIF)."),
+    page: Optional[Path] = typer.Option(None, "--html", help="A page to look at and listen to (HTML): the sound, "
+                                        "the spectrogram with tiers and movement, the animation (drawn beside it)."),
 ):
     """Speak a sequence of targets: each solved once, its forces ramped in at its segment's start and held, the
     whole simulated with contact, then the tract, formants and sound (WAV, TextGrid, HDF5)."""
@@ -44,7 +46,9 @@ def speak_cmd(
 
     check_number("--budget", budget, ge=1)
     check_number("--jobs", jobs, ge=1)
-    for opt, p, ext in (("--plot", plot, ".png"), ("--animate", animate, ".gif")):
+    if page is not None:  # the page's pictures are drawn beside it
+        plot, animate = plot or page.with_suffix(".png"), animate or page.with_suffix(".gif")
+    for opt, p, ext in (("--plot", plot, ".png"), ("--animate", animate, ".gif"), ("--html", page, ".html")):
         if p is not None and (p.suffix.lower() != ext or not p.parent.is_dir()):
             raise ArticError(f"{opt} {p}: give a {ext} file in an existing folder")
     say = lambda m: err_console.print(m, highlight=False)  # noqa: E731
@@ -54,6 +58,24 @@ def speak_cmd(
     _report(res)
     if plot is not None or animate is not None:
         _draw(res.paths, plot, animate, mesh, config)
+    if page is not None:
+        _page(res.paths, page, plot, animate)
+
+
+def _page(files: dict, page: Path, plot: Path, animate: Path) -> None:
+    import os
+
+    from ..io.store import write_text_atomic
+    from ..report.html import utterance_page
+    from ..stages import speak as speak_stage
+
+    rec = speak_stage.read(files["h5"])
+    rel = lambda p: os.path.relpath(p, page.parent)  # noqa: E731
+    rows = [(lab, f"{s:.3f}", f"{1e3 * d:.0f}", how) for lab, s, d, how in zip(rec.labels, rec.starts_s,
+                                                                              rec.durations_s, rec.how)]
+    text = utterance_page(str(rec.attrs.get("name", page.stem)), rel(files["wav"]), rel(plot), rel(animate), rows,
+                          rel(files["textgrid"]))
+    out_console.print(f"wrote {write_text_atomic(page, text)}", highlight=False)
 
 
 def _report(res) -> None:

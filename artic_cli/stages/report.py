@@ -6,6 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..io.store import write_text_atomic
+from ..report.html import to_html
 from ..report.maps import map_section
 from ..report.mechanics import articulator_section, function_rows, tissue_section
 from ..report.run import run_section
@@ -24,6 +25,7 @@ SECTIONS = {"tissue": tissue_section, "articulator": articulator_section, "tract
 
 
 def write_report(data: Path | str = paths.DATA, out: Path | str = paths.REPORT) -> Path:
+    """``out`` (markdown) and, beside it, the same text as a page to look at and listen to (``.html``)."""
     from .table import REPORT
 
     data, out = Path(data), Path(out)
@@ -37,4 +39,6 @@ def write_report(data: Path | str = paths.DATA, out: Path | str = paths.REPORT) 
         lines += ["| item | paper | ours | verdict |", "|---|---|---|---|"]
         lines += [f"| {r.item} | {r.paper} | {r.ours} | {r.verdict} |" for r in rows]
     lines.append("")
-    return write_text_atomic(out, "\n".join(lines))
+    text = "\n".join(lines)
+    write_text_atomic(out.with_suffix(".html"), to_html(text))
+    return write_text_atomic(out, text)

@@ -11,7 +11,7 @@ import h5py
 import numpy as np
 import pytest
 
-from conftest import ROOT, newly_differing, praat_formants_near, report_rows
+from conftest import ROOT, browser_check, need, newly_differing, praat_formants_near, report_rows
 
 VENV = ROOT / ".venv"
 pytestmark = [pytest.mark.slow, pytest.mark.skipif(not (VENV / ".installed").exists() or shutil.which("make") is None,
@@ -217,3 +217,44 @@ def test_make_paper_runs_the_ep_maps_first_and_the_muscle_function_study_last_ea
     assert {"$(OUT)/epmaps.h5", "$(OUT)/utterances/aia.h5", "$(REPORT)/fig8_epmap.png"} <= waits
     assert not any("muscle_function" in w or "fig5" in w for w in waits)
     assert "MAKEFLAGS += -j$(JOBS)" in (ROOT / "Makefile").read_text()
+
+
+def _cells(fragment: str) -> list[str]:
+    """The text of each <td> of an HTML table row."""
+    import html
+
+    return [html.unescape(re.sub(r"<[^>]+>", "", c)).strip() for c in re.findall(r"<td[^>]*>(.*?)</td>", fragment, re.S)]
+
+
+def test_the_html_report_carries_the_markdown_reports_rows(built):
+    """paper.html is paper.md's text rendered: the same rows in the same order, every cell's text the same."""
+    import html
+
+    import markdown
+
+    md_rows = report_rows(built / "reports" / "paper.md")
+    page = (built / "reports" / "paper.html").read_text()
+    html_rows = [c for c in (_cells(r) for r in re.findall(r"<tr>(.*?)</tr>", page, re.S)) if len(c) == 4]
+    as_text = lambda cell: html.unescape(re.sub(r"<[^>]+>", "", markdown.markdown(cell))).strip()  # noqa: E731
+    assert len(html_rows) == len(md_rows) >= 40
+    assert html_rows == [[as_text(c) for c in r] for r in md_rows]
+
+
+def test_the_html_report_opens_in_a_browser_with_every_picture_and_sound(built, tmp_path):
+    """Headless Chromium opens paper.html from the file system: the page parses strictly (html5lib), every
+    image it shows loads, every sound it plays decodes (a duration), no link points to a missing file; a
+    screenshot of the top is taken."""
+    html5lib = need("html5lib")
+    page = built / "reports" / "paper.html"
+    text = page.read_text()
+    html5lib.HTMLParser(strict=True).parse(text)  # raises on any parse error
+    for ref in re.findall(r'(?:href|src)="([^"#][^"]*)"', text):
+        assert (page.parent / ref).is_file(), ref
+    got = browser_check(page, tmp_path, tmp_path / "top.png")
+    shot = (tmp_path / "top.png").read_bytes()
+    assert shot[:8] == b"\x89PNG\r\n\x1a\n" and len(shot) > 50_000
+    figures = re.findall(r"\]\(([\w.-]+\.png)\)", (built / "reports" / "paper.md").read_text())
+    assert len(got["images"]) == len(figures) >= 12 and all(w > 0 for _, w in got["images"]), got["images"]
+    sounds = re.findall(r'<audio[^>]* src="([^"]+)"', text)
+    assert len(got["audio"]) == len(sounds) >= 7, got["audio"]  # the rest tract, five vowels, an utterance
+    assert all(d > 0 and err == 0 for _, d, err in got["audio"]), got["audio"]

@@ -433,3 +433,21 @@ def test_praat_finds_our_formant_tracks_in_the_spoken_sound(spoken):
             assert abs(nearest / ours[k] - 1) < tol, (lab, k + 1, nearest, ours[k], found)
             heard[lab].append(nearest)
     assert heard["i"][1] >= 1.15 * heard["a"][1] and heard["i"][0] <= heard["a"][0] / 1.15, heard
+
+
+def test_a_spoken_utterance_gets_a_page_to_look_at_and_listen_to(spoken, mesh_file, tmp_path):
+    """`artic speak ... --html PAGE.html`: a page that parses strictly, whose pictures (spectrogram with tiers
+    and movement, the animation) load and whose sound decodes in headless Chromium, opened from the file
+    system."""
+    from conftest import browser_check
+
+    html5lib = need("html5lib")
+    page = spoken / "lab_page.html"
+    res = _run("speak", spoken / "lab.yaml", "--mesh", mesh_file, "--out", spoken / "lab.wav", "--html", page)
+    assert res.exit_code == 0 and page.is_file(), res.output
+    text = page.read_text()
+    html5lib.HTMLParser(strict=True).parse(text)
+    got = browser_check(page, tmp_path, tmp_path / "page.png")
+    assert [src for src, _ in got["images"]] == ["lab_page.png", "lab_page.gif"] and all(w > 0 for _, w in got["images"])
+    assert got["audio"] == [["lab.wav", pytest.approx(1.0, abs=0.01), 0]]
+    assert text.count("<tr>") == 7  # a header and the six segments
