@@ -47,20 +47,28 @@ def _summary(sections: list[tuple[str, str, int, int]]) -> str:
             f"</tr></thead><tbody>{rows}<tr><th>all</th><th>{ok}</th><th>{bad}</th></tr></tbody></table>")
 
 
+def _players(body: str) -> str:
+    """Every link to a WAV with an audio player before it."""
+    return _WAV.sub(lambda m: f'<audio controls preload="metadata" src="{m.group(1)}"></audio>'
+                              f'<a href="{m.group(1)}">{m.group(2)}</a>', body)
+
+
+def _document(title: str, body: str) -> str:
+    return ("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+            f"<title>{html.escape(title)}</title>\n<style>{STYLE}</style>\n</head>\n<body>\n{body}\n</body>\n</html>\n")
+
+
 def to_html(md_text: str, title: str = "artic beside Dang & Honda (2004)") -> str:
     """The page of a report's markdown text."""
     conv = markdown.Markdown(extensions=["tables", "toc"])
     body = conv.convert(md_text)
     body = _VERDICT.sub(lambda m: f'<td class="{"open" if m.group(1) == "not compared" else m.group(1)}">{m.group(1)}',
                         body)
-    body = _WAV.sub(lambda m: f'<audio controls preload="metadata" src="{m.group(1)}"></audio>'
-                              f'<a href="{m.group(1)}">{m.group(2)}</a>', body)
+    body = _players(body)
     head, sep, rest = body.partition("</p>")  # after the report's opening paragraph: summary and contents
     top = (f"<h2>Summary</h2>{_summary(_sections(body))}"
            f'<nav class="toc"><strong>Contents</strong>{conv.toc}</nav>')
-    body = head + sep + top + rest if sep else top + body
-    return ("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
-            f"<title>{html.escape(title)}</title>\n<style>{STYLE}</style>\n</head>\n<body>\n{body}\n</body>\n</html>\n")
+    return _document(title, head + sep + top + rest if sep else top + body)
 
 
 def utterance_page(name: str, wav: str, picture: str, animation: str | None, rows: list[tuple[str, str, str, str]],
@@ -75,8 +83,4 @@ def utterance_page(name: str, wav: str, picture: str, animation: str | None, row
                       "tip / dorsum / jaw heights](" + picture + ")", ""]
                      + ([f"![/{name}/: the midsagittal view moving]({animation})", ""] if animation else [])
                      + [table, ""])
-    body = markdown.markdown(text, extensions=["tables"])
-    body = _WAV.sub(lambda m: f'<audio controls preload="metadata" src="{m.group(1)}"></audio>'
-                              f'<a href="{m.group(1)}">{m.group(2)}</a>', body)
-    return ("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
-            f"<title>/{html.escape(name)}/</title>\n<style>{STYLE}</style>\n</head>\n<body>\n{body}\n</body>\n</html>\n")
+    return _document(f"/{name}/", _players(markdown.markdown(text, extensions=["tables"])))
