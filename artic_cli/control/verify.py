@@ -43,6 +43,11 @@ class Simulator:
                            "code": code_hash("artic_cli.control.equilibrium")})
         self.cfg_json = json.dumps(cfg.model_dump(mode="json"))
 
+    @property
+    def simulation(self) -> "Simulator":
+        """The plain simulator (itself; a :class:`~.voicing.Voicer` answers with the one it wraps)."""
+        return self
+
     def conditions(self) -> dict:
         """How this simulator checks an answer (what a solution file records, and what replays it)."""
         if self.hold_jaw:

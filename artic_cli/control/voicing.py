@@ -17,6 +17,10 @@ class Voicer:
         self.vt = speaker_tract(cfg)
         self.mesh_sha256 = sim.mesh_sha256
 
+    @property
+    def simulation(self) -> Simulator:
+        return self.sim
+
     def reach(self, jaw_forces: dict[str, float], forces: dict[str, float]):
         return self.sim.reach(jaw_forces, forces)
 

@@ -116,9 +116,10 @@ class Model:
     mirrored: np.ndarray | None = None  # (H,) the nodes that move as their image's mirror (no dofs of their own)
     fibre_twin: np.ndarray | None = None  # (F,) each fibre's mirror twin when mirrored (itself on the midline)
 
-    @property
+    @cached_property
     def terms(self) -> tuple[ForceTerm, ...]:
-        """The force terms this model has (its wall, muscles, guide: when present)."""
+        """The force terms this model has (its wall, muscles, guide: when present); found once per model (a
+        changed model, ``dataclasses.replace``, is a new one)."""
         return tuple(t for t in self.force_terms if t.present(self))
 
     def mirror(self, x: np.ndarray) -> np.ndarray:

@@ -100,7 +100,7 @@ def solve_target(target: Path | str | TargetSpec, ctx: Context, out: Path | str 
         cfg = load_config(config)
         inputs["acoustic_maps"] = ctx.acoustic_sha256
         sections = STAGE.sections
-    checked = getattr(sim, "sim", sim)  # a Voicer's simulator
+    checked = None if sim is None else sim.simulation
     held = bool(checked.hold_jaw) if (verify or refine) and checked is not None else None
     prov = STAGE.provenance(cfg, inputs=inputs, params={"verify": verify, "refine": refine, "budget": budget,
                                                         "hold_jaw": held},

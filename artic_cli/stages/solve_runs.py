@@ -109,7 +109,7 @@ def solve_files(target: Path | str | None = None, batch: Path | str | None = Non
         add_formants(ctx, maps, mesh, config, acoustic_maps)
     sim = simulator(mesh, config, voiced=acoustic, hold_jaw=hold_jaw) if (verify or refine) else None
     if batch is not None:
-        base = getattr(sim, "sim", sim)  # a Voicer's simulator
+        base = None if sim is None else sim.simulation
         args = None if base is None else (base.cfg, base.mesh, base.wall, base.mesh_sha256, base.hold_jaw)
         rows = solve_rows(ctx, targets, jobs, args, verify, refine, budget, progress)
         path = Path(out) if out is not None else paths.SOLUTIONS / f"{Path(batch).stem}.csv"
