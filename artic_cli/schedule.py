@@ -69,9 +69,10 @@ class TractEntry(Strict):
     lip_area_cm2: AreaCm2 | None = None
     lip_length_cm: Annotated[float, Field(gt=0, le=3, allow_inf_nan=False)] | None = None
     velum_port_cm2: AreaCm2 | None = None
+    glottis_cm2: Annotated[float, Field(ge=0, le=2, allow_inf_nan=False)] | None = None  # its mean opening
 
 
-TRACT_CONTROLS = ("lip_area_cm2", "lip_length_cm", "velum_port_cm2")
+TRACT_CONTROLS = ("lip_area_cm2", "lip_length_cm", "velum_port_cm2", "glottis_cm2")
 
 
 def tract_controls(entries: list[TractEntry], start: dict[str, float], time_s) -> dict[str, np.ndarray]:

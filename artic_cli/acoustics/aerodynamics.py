@@ -60,3 +60,27 @@ def turbulence(length_cm: np.ndarray, area_cm2: np.ndarray, glottis_cm2: np.ndar
     u = flow(np.full(len(A), lung_pressure), glottis_cm2, ac, rho)
     return Turbulence(flow_cm3_s=u, reynolds=reynolds(u, ac, rho, mu),
                       noise_rms_dyn_cm2=noise_rms(u, ac, rho, mu, critical, gain), at_cm=ends, constriction_cm2=ac)
+
+
+def glottal_noise_rms(u: np.ndarray, glottis_cm2: np.ndarray, rho: float, mu: float, critical: float,
+                      coefficient: float) -> np.ndarray:
+    """Aspiration: the RMS pressure (dyn/cm^2) of the turbulence the glottal jet makes, Flanagan &
+    Ishizaka (1976)'s source coefficient x r x (Re^2 - Re_c^2) above the critical Reynolds number with r
+    uniform in [-1/2, 1/2] (as Sondhi & Schroeter 1987 give it; its RMS is 1 / sqrt(12)): it grows with the
+    flow and the opening, so an abducted glottis (/h/, an aspirated release) is far noisier than a voicing
+    one."""
+    re = reynolds(np.abs(np.asarray(u, float)), glottis_cm2, rho, mu)
+    return coefficient / np.sqrt(12.0) * np.maximum(re * re - critical * critical, 0.0)
+
+
+def voice_gain(transglottal: np.ndarray, lung_pressure: float, glottis_cm2: np.ndarray, threshold: float,
+               voiced_cm2: float, stops_cm2: float) -> np.ndarray:
+    """The voice's amplitude (0-1) for the transglottal pressure and the glottis's mean opening: the folds
+    vibrate above the phonation threshold pressure, their amplitude growing as sqrt(dP - P_th) past it (a
+    Hopf onset: Lucero 1995) and the flow through them as sqrt(dP) (Bernoulli), both 1 at the lung pressure
+    with the tract open; abducted past ``stops_cm2`` they do not meet and stop (linear from ``voiced_cm2``)."""
+    dp = np.asarray(transglottal, float)
+    onset = np.sqrt(np.clip((dp - threshold) / max(lung_pressure - threshold, 1e-9), 0.0, 1.0))
+    flow = np.sqrt(np.clip(dp / lung_pressure, 0.0, 1.0))
+    adduction = np.clip((stops_cm2 - np.asarray(glottis_cm2, float)) / max(stops_cm2 - voiced_cm2, 1e-9), 0.0, 1.0)
+    return onset * flow * adduction

@@ -24,9 +24,12 @@ the audio rate by a polyphase filter.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from ..jit import njit
+from .nasal import NasalLine
 
 MIN_AREA_CM2 = 1e-4
 
@@ -86,64 +89,162 @@ def _lips_reflect(a_l, f_now, last_f, last_b, rho, c, fs):  # pragma: no cover -
 
 
 @njit(cache=True)
+def _value_at(frame_values, pos):  # pragma: no cover - compiled
+    """One value per frame at fractional frame ``pos`` (linear between frames)."""
+    last = frame_values.shape[0] - 1
+    if last <= 0:
+        return frame_values[0]
+    k0 = min(int(pos), last - 1)
+    w = pos - k0
+    return (1.0 - w) * frame_values[k0] + w * frame_values[k0 + 1]
+
+
+@njit(cache=True)
+def _shunted(into, a_sum, rho_c, areas, cs, ds):  # pragma: no cover - compiled
+    """A junction's pressure (dyn/cm^2) with shunts that each take area x velocity, a velocity (c + p) / d
+    (backward Euler on m dv/dt = p - r v - k x: c = m v / dt - k x, d = m / dt + r + k dt)."""
+    num = into
+    den = a_sum
+    for i in range(areas.shape[0]):
+        if areas[i] > 0.0:
+            num -= areas[i] * cs[i] / ds[i]
+            den += rho_c * areas[i] / ds[i]
+    return rho_c * num / den
+
+
+@njit(cache=True)
+def _nasal_step(nl_areas, sinus_at, sinus_m, sinus_k, sinus_a, nf, nb, new_nf, new_nb, sv, sx, wv, wx,
+                wall, keep, dt, dx, rho, c, fs, nostril, rad):  # pragma: no cover - compiled
+    """One sample of the nasal branch (``new_nf[0]`` set by the caller): its junctions with their yielding
+    walls and sinuses, the nostrils radiating; returns the nostrils' volume velocity."""
+    m = nl_areas.shape[0]
+    rho_c = rho * c
+    sh_a, sh_c, sh_d = np.zeros(2), np.zeros(2), np.ones(2)
+    for k in range(m - 1):
+        a_sum = nl_areas[k] + nl_areas[k + 1]
+        into = 2.0 * (nl_areas[k] * nf[k] + nl_areas[k + 1] * nb[k + 1])
+        sh_a[0] = 0.0
+        sh_a[1] = 0.0
+        if wall[0] > 0.0:
+            sh_a[0] = 2.0 * np.sqrt(np.pi * 0.5 * a_sum) * dx
+            sh_c[0] = (wall[0] / dt) * wv[k] - wall[2] * wx[k]
+            sh_d[0] = wall[0] / dt + wall[1] + wall[2] * dt
+        q = sinus_at[k]
+        if q >= 0:
+            sh_a[1] = sinus_a[q]
+            sh_c[1] = (sinus_m[q] / dt) * sv[q] - sinus_k[q] * sx[q]
+            sh_d[1] = sinus_m[q] / dt + sinus_k[q] * dt
+        p = _shunted(into, a_sum, rho_c, sh_a, sh_c, sh_d)
+        if sh_a[0] > 0.0:
+            wv[k] = (sh_c[0] + p) / sh_d[0]
+            wx[k] += dt * wv[k]
+        if q >= 0:
+            sv[q] = (sh_c[1] + p) / sh_d[1]
+            sx[q] += dt * sv[q]
+        pj = p / rho_c
+        new_nf[k + 1] = pj - nb[k + 1]
+        new_nb[k] = pj - nf[k]
+    new_nb[m - 1] = _lips_reflect(nostril, nf[m - 1], rad[0], rad[1], rho, c, fs)
+    rad[0] = nf[m - 1]
+    rad[1] = new_nb[m - 1]
+    u = nostril * (nf[m - 1] - new_nb[m - 1])
+    for k in range(m):
+        nf[k] = keep * new_nf[k]
+        nb[k] = keep * new_nb[k]
+    return u
+
+
+@njit(cache=True)
 def _line(frame_areas, frame_index, source, glottal_reflection, rho, c, fs, loss, branch_at,
-          branch_areas, noise, noise_at, wall_m, wall_r, wall_k):  # pragma: no cover - compiled
+          branch_areas, noise, noise_at, wall_m, wall_r, wall_k, nasal_at, nasal_areas, nasal_port,
+          frame_ports, sinus_at, sinus_m, sinus_k, sinus_a, nostril, aspiration, inject, inject_at,
+          skin):  # pragma: no cover - compiled
     n_samples = source.shape[0]
     n = frame_areas.shape[1]
-    fwd = np.zeros(n)
-    bwd = np.zeros(n)
-    new_f = np.zeros(n)
-    new_b = np.zeros(n)
-    area = np.zeros(n)
+    fwd, bwd, new_f, new_b, area = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
     m = branch_areas.shape[0]
-    bf = np.zeros(m)  # the side branch: waves away from its junction ...
-    bb = np.zeros(m)  # ... and toward it
-    new_bf = np.zeros(m)
-    new_bb = np.zeros(m)
+    bf, bb, new_bf, new_bb = np.zeros(m), np.zeros(m), np.zeros(m), np.zeros(m)  # the fossa: away, toward
+    nm = nasal_areas.shape[0]
+    nas = nasal_areas.copy()
+    nf, nb, new_nf, new_nb = np.zeros(nm), np.zeros(nm), np.zeros(nm), np.zeros(nm)  # the nasal branch
+    nwv, nwx, sv, sx, rad = np.zeros(nm), np.zeros(nm), np.zeros(len(sinus_a)), np.zeros(len(sinus_a)), np.zeros(2)
     out = np.zeros(n_samples)
-    last_u = 0.0
+    last_u, last_f, last_b = 0.0, 0.0, 0.0
     keep = 1.0 - loss
-    last_f = 0.0
-    last_b = 0.0
     pi = np.pi
     wall_x = np.zeros(n)  # each junction's wall patch: displacement (cm) and velocity (cm/s)
     wall_v = np.zeros(n)
     walls = wall_m > 0.0
+    wall = np.array([wall_m, wall_r, wall_k])
     dt = 1.0 / fs
     dx = c / fs
+    was_open = False
     for s in range(n_samples):
         _areas_at(frame_areas, frame_index[s], area)
+        port = _value_at(frame_ports, frame_index[s]) if nm > 0 else 0.0
+        nasal = port > MIN_AREA_CM2
+        if nasal:
+            nas[:nasal_port] = port
         new_f[0] = glottal_reflection * bwd[0] + source[s] / area[0]
+        skin_u = 0.0
         for j in range(n - 1):  # each junction's pressure p / (rho c) = f + b from the flows U = A (f - b) into it
             a_sum = area[j] + area[j + 1]
             into = 2.0 * (area[j] * fwd[j] + area[j + 1] * bwd[j + 1])
+            if j == inject_at[s]:  # the air through a constriction as it starts and stops (a release's transient)
+                into += inject[s]
+            main = a_sum
+            if nasal and j == nasal_at:  # the port: the nasal branch's flow joins
+                a_sum += port
+                into += 2.0 * port * nb[0]
             if j == branch_at:  # three tubes meet: the side branch's flow joins
                 a_sum += branch_areas[0]
                 into += 2.0 * branch_areas[0] * bb[0]
             elif walls:  # less what the junction's wall patch takes; the wall's velocity and the pressure solved
                 # together (backward Euler): stable for any area, a closure's slit included
-                patch = 2.0 * np.sqrt(pi * 0.5 * a_sum) * dx
+                patch = 2.0 * np.sqrt(pi * 0.5 * main) * dx
                 wall_v[j] = ((wall_m / dt) * wall_v[j] + rho * c * into / a_sum - wall_k * wall_x[j]) / (
                     wall_m / dt + rho * c * patch / a_sum + wall_r + wall_k * dt)
                 wall_x[j] += dt * wall_v[j]
                 into -= patch * wall_v[j]
+                skin_u += patch * wall_v[j]
             pj = into / a_sum
             new_f[j + 1] = pj - bwd[j + 1]
             new_b[j] = pj - fwd[j]
             if j == branch_at:
                 new_bf[0] = pj - bb[0]
+            if nasal and j == nasal_at:
+                new_nf[0] = pj - nb[0]
         k_n = noise_at[s]
         if 0 <= k_n < n - 1:  # a series pressure source between sections k_n and k_n + 1: half each way
             half = 0.5 * noise[s] / (rho * c)
             new_f[k_n + 1] += half
             new_b[k_n] -= half
+        if aspiration.shape[0] > 0:  # the glottis's turbulence, just above it
+            half = 0.5 * aspiration[s] / (rho * c)
+            new_f[1] += half
+            new_b[0] -= half
         if m > 0:
             _branch_step(branch_areas, bf, bb, new_bf, new_bb, keep)
+        u_nose = 0.0
+        if nasal:
+            u_nose = _nasal_step(nas, sinus_at, sinus_m, sinus_k, sinus_a, nf, nb, new_nf, new_nb, sv, sx, nwv,
+                                 nwx, wall, keep, dt, dx, rho, c, fs, nostril, rad)
+            was_open = True
+        elif was_open:  # the port shut: the nasal tract's air column is cut off, its waves gone
+            for arr in (nf, nb, nwv, nwx, sv, sx, rad):
+                arr[:] = 0.0
+            was_open = False
         a_l = area[n - 1]
         new_b[n - 1] = _lips_reflect(a_l, fwd[n - 1], last_f, last_b, rho, c, fs)
         last_f = fwd[n - 1]
         last_b = new_b[n - 1]
         u = area[n - 1] * (fwd[n - 1] - new_b[n - 1]) if a_l > 2e-4 else 0.0  # closed lips radiate nothing
+        if nasal:
+            u += u_nose
+        if inject_at[s] == n - 1:  # the air leaving through the lips' own constriction
+            u += inject[s]
+        if skin > 0.0:  # the yielding walls move the skin of the neck and cheeks: they radiate too
+            u += skin * skin_u
         out[s] = u - last_u
         last_u = u
         for j in range(n):
@@ -199,26 +300,67 @@ def noise_samples(frame_times_s: np.ndarray, rms: np.ndarray, at_fraction: np.nd
     return level * np.random.default_rng(seed).standard_normal(len(t_s)), k
 
 
+@dataclass
+class Extra:
+    """The line's sources and branches beyond the voice, each optional (per internal sample where an array):
+    ``nasal`` (the nasal branch, from :func:`artic_cli.acoustics.nasal.nasal_line`) with the port's area per
+    frame ``frame_ports_cm2``; ``aspiration``: a pressure source just above the glottis (dyn/cm^2);
+    ``inject``/``inject_at``: a volume velocity (cm^3/s) entering the junction after section ``inject_at`` (-1:
+    none); ``voice_gain``: the voice's flow times this; ``skin``: the share of the yielding walls' volume
+    velocity that radiates (0: none)."""
+
+    nasal: NasalLine | None = None
+    frame_ports_cm2: np.ndarray | None = None
+    aspiration: np.ndarray | None = None
+    inject: np.ndarray | None = None
+    inject_at: np.ndarray | None = None
+    voice_gain: np.ndarray | None = None
+    skin: float = 0.0
+
+
+def _extra_arrays(x: Extra, n_samples: int, n: int, branch_at: int) -> tuple:
+    nl = x.nasal
+    if nl is None or x.frame_ports_cm2 is None:
+        nasal = (-1, np.zeros(0), 0, np.zeros(1), np.zeros(0, np.int64), np.zeros(0), np.zeros(0), np.zeros(0), 1.0)
+    else:
+        at = nl.at if nl.at != branch_at else min(nl.at + 1, n - 2)
+        nasal = (int(at), np.asarray(nl.areas_cm2, float), int(nl.port_sections),
+                 np.ascontiguousarray(x.frame_ports_cm2, dtype=float), np.asarray(nl.sinus_junction, np.int64),
+                 nl.sinus_mass, nl.sinus_stiffness, nl.sinus_area_cm2, float(nl.nostril_area_cm2))
+    asp = np.zeros(0) if x.aspiration is None else np.ascontiguousarray(x.aspiration, dtype=float)
+    if x.inject is None:
+        inject, inject_at = np.zeros(n_samples), np.full(n_samples, -1, np.int64)
+    else:
+        inject, inject_at = (np.ascontiguousarray(x.inject, dtype=float),
+                             np.ascontiguousarray(x.inject_at, dtype=np.int64))
+    return (*nasal, asp, inject, inject_at, float(x.skin))
+
+
 def synthesize(frame_areas: np.ndarray, frame_times_s: np.ndarray, source: np.ndarray, fs_internal: float,
                glottal_reflection: float = 0.97, section_loss: float = 5e-4, rho: float = 1.14e-3,
                c: float = 35000.0, branch: tuple[int, np.ndarray] | None = None, flow_peak_cm3_s: float | None = None,
                noise: tuple[np.ndarray, np.ndarray] | None = None,
-               walls: tuple[float, float, float] | None = None) -> np.ndarray:
+               walls: tuple[float, float, float] | None = None, extra: Extra | None = None) -> np.ndarray:
     """The radiated sound at ``fs_internal`` for areas (frames x N equal sections) at ``frame_times_s`` and a
     source (flow derivative per internal sample); ``branch``: a closed side tube, (the section after which it
     joins, its areas), from :func:`side_branch`; ``flow_peak_cm3_s``: the glottal flow's peak (else arbitrary
     units); ``noise``: a pressure source per internal sample (dyn/cm^2) and the section after which it acts (-1:
     none), on the same scale as a flow of ``flow_peak_cm3_s``; ``walls``: (mass g/cm^2, resistance dyn s/cm^3,
-    stiffness dyn/cm^3) per unit area of yielding wall (None: rigid)."""
+    stiffness dyn/cm^3) per unit area of yielding wall (None: rigid); ``extra``: the nasal branch and the
+    aerodynamic sources (:class:`Extra`; None: none, the line as it was before them, bit for bit)."""
     t = np.arange(len(source)) / fs_internal
     index = np.interp(t, frame_times_s, np.arange(len(frame_times_s))) if len(frame_times_s) > 1 else np.zeros(len(t))
     # the source drives flow: integrate its derivative (leaky, so no drift) before it enters the line
     flow = _leaky_integral(np.ascontiguousarray(source, dtype=float), 1.0 / fs_internal, 0.999)
     peak = float(np.max(np.abs(flow))) if len(flow) else 0.0
     flow = flow * (flow_peak_cm3_s / peak if flow_peak_cm3_s is not None and peak > 0 else 1e4)
+    extra = Extra() if extra is None else extra
+    if extra.voice_gain is not None:
+        flow = flow * extra.voice_gain
     at, areas = (-1, np.zeros(0)) if branch is None else (int(branch[0]), np.asarray(branch[1], dtype=float))
     p_noise, k_noise = (np.zeros(len(source)), np.full(len(source), -1, np.int64)) if noise is None else noise
     return _line(np.ascontiguousarray(frame_areas, dtype=float), index.astype(float), flow,
                  glottal_reflection, rho, c, float(fs_internal), section_loss, at, areas,
                  np.ascontiguousarray(p_noise, dtype=float), np.ascontiguousarray(k_noise, dtype=np.int64),
-                 *((0.0, 0.0, 0.0) if walls is None else tuple(float(v) for v in walls)))
+                 *((0.0, 0.0, 0.0) if walls is None else tuple(float(v) for v in walls)),
+                 *_extra_arrays(extra, len(source), frame_areas.shape[1], at))

@@ -91,3 +91,41 @@ def radiated_pressure(h: np.ndarray, f_hz: np.ndarray, air: Air, distance_cm: fl
     """(F,) far-field pressure per unit glottal flow: j w rho H / (4 pi r) (a simple source at the lips)."""
     w = 2.0 * np.pi * np.asarray(f_hz, dtype=float)
     return 1j * w * air.rho * h / (4.0 * np.pi * distance_cm)
+
+
+def _chain_between(tract: Tract, w: np.ndarray, air: Air, first: int, last: int, skip: int | None) -> np.ndarray:
+    """(F, 2, 2) the split tube's sections ``first:last`` with the shunts of the branches on them (the
+    branch ``skip`` left out)."""
+    t, cut = tract.plan()
+    total = np.broadcast_to(np.eye(2, dtype=complex), (len(w), 2, 2)).copy()
+    start = first
+    for idx, j in [c for c in cut if first <= c[0] <= last] + [(last, None)]:
+        if idx > start:
+            total = total @ chain(t.length_cm[start:idx], t.area_cm2[start:idx], w, air)
+            start = idx
+        if j is not None and j != skip and idx < last:
+            total = total @ shunt(_branch_admittance(tract.branches[j], w, air))
+    return total
+
+
+def nostril_transfer(tract: Tract, f_hz: np.ndarray, air: Air) -> np.ndarray:
+    """(F,) complex U_nostrils / U_glottis: the volume velocity out of the radiating branch (the nasal tract)
+    per unit glottal flow; zeros when the tract has none.  The lips' and the nostrils' flows add in the
+    sound (:func:`radiated_pressure` of their sum)."""
+    w = 2.0 * np.pi * np.maximum(np.asarray(f_hz, dtype=float), 1e-3)
+    nasal = [j for j, b in enumerate(tract.branches) if b.radiating]
+    if not nasal:
+        return np.zeros(len(w), dtype=complex)
+    j = nasal[0]
+    t, cut = tract.plan()
+    at = next(idx for idx, k in cut if k == j)
+    before = _chain_between(tract, w, air, 0, at, j)  # glottis to the port
+    after = _chain_between(tract, w, air, at, len(t.length_cm), j)  # the port to the lips
+    b = tract.branches[j]
+    y_nose = _branch_admittance(b, w, air)
+    y_j = 1.0 / input_impedance(after, radiation_impedance(tract.tube.area_cm2[-1], w, air)) + y_nose
+    p_j = 1.0 / (before[:, 1, 0] + before[:, 1, 1] * y_j)  # per unit glottal flow
+    k_n = tract_chain(Tract(b.tube, list(b.branches)), w, air) if b.branches else \
+        chain(b.tube.length_cm, b.tube.area_cm2, w, air)
+    z_n = radiation_impedance(b.tube.area_cm2[-1], w, air)
+    return p_j * y_nose / (k_n[:, 1, 0] * z_n + k_n[:, 1, 1])

@@ -78,6 +78,32 @@ class Synthesis(Strict):
     lf_ta: Annotated[float, Field(gt=0, lt=0.1)] = 0.012  # return phase
 
 
+class Sources(Strict):
+    """The synthesis's sources beyond the LF voice and the frication noise, each switchable for comparison
+    (docs/modelling.md, "Sources"): the nasal branch, the air in time (the cavity's pressure as a state:
+    the voice follows the transglottal pressure and the glottis's opening, a release's burst), the voice bar,
+    aspiration at the glottis."""
+
+    nasal_branch: bool = True  # the nasal tract as a side branch of the line, sounding at the nostrils
+    # the voice's amplitude follows the transglottal pressure and the glottis's adduction (off: a switch per
+    # segment, voiced or not, ramped over speech.voicing_ramp_ms)
+    aerodynamic_voicing: bool = True
+    # below this transglottal pressure the folds stop vibrating (Westbury & Keating 1986: 2 cm H2O)
+    phonation_threshold_kpa: Annotated[float, Field(gt=0, le=2, allow_inf_nan=False)] = 0.2
+    # the folds vibrate fully at vocal_tract.glottis_cm2 and not at all from this opening on
+    voicing_stops_at_cm2: Annotated[float, Field(gt=0, le=2, allow_inf_nan=False)] = 0.2
+    bursts: bool = True  # the cavity's pressure as a state and a release's flow transient (off: quasi-steady)
+    # the walls' resistance as the cavity behind a closure sees them (the line's own is for the formants'
+    # bandwidths): Ishizaka, French & Flanagan (1975)'s measured 1600 dyn s/cm^3
+    cavity_wall_resistance_dyn_s_cm3: Annotated[float, Field(gt=0, le=1e5, allow_inf_nan=False)] = 1600.0
+    voice_bar: bool = True  # the yielding walls' volume velocity radiates through the neck and cheeks
+    aspiration: bool = True  # turbulence at the glottis (Flanagan's model)
+    # its pressure source's RMS per squared Reynolds number above the critical one (dyn/cm^2; Flanagan &
+    # Ishizaka 1976, the coefficient as Sondhi & Schroeter 1987 use it)
+    aspiration_coefficient: Annotated[float, Field(ge=0, le=1e-3, allow_inf_nan=False)] = 2e-6
+    seed: Annotated[int, Field(ge=0)] = 1  # the aspiration noise's
+
+
 class Acoustics(Strict):
     """Air, walls and losses of the frequency-domain tube model (CGS; Maeda 1982, Ishizaka et al. 1975;
     ../shared/reference/acoustics.md), each loss switchable."""
@@ -109,6 +135,7 @@ class Acoustics(Strict):
     nasal: NasalTract = NasalTract()
     piriform_fossa: PiriformFossa = PiriformFossa()
     synthesis: Synthesis = Synthesis()
+    sources: Sources = Sources()
 
 
 class AreaRegion(Strict):
@@ -154,6 +181,9 @@ class VocalTract(Strict):
     hard_palate_end_x_cm: Finite = -5.2
     velum_nasal_surface_cm: Outline  # the velum's posterior surface, hard palate end to the uvula (drawn)
     velum_port_cm2: NonNeg = 0.0  # the velopharyngeal port's default opening (a control input; 0: closed)
+    # the glottis's mean opening (a control input): adducted, as while voicing (mean flow about 180 cm^3/s at
+    # 0.8 kPa); a voiceless segment opens it to speech.glottal_area_voiceless_cm2
+    glottis_cm2: Annotated[float, Field(gt=0, le=2, allow_inf_nan=False)] = 0.05
     velum_port_line_cm: Annotated[list[Point2], Field(min_length=2, max_length=2)]  # the oral tract's top behind the velum
     pharynx_lower_cm: Outline  # the posterior wall below the contact wall's pharynx, down to the glottis
     larynx_front_cm: Outline  # glottis front, the laryngeal vestibule, the epiglottis to its tip
@@ -210,7 +240,6 @@ class Speech(Strict):
     lip_ramp_ms: Annotated[float, Field(ge=0, le=500, allow_inf_nan=False)] = 60.0  # the lips and velum move over this
     voicing_ramp_ms: Annotated[float, Field(ge=1, le=200, allow_inf_nan=False)] = 20.0  # voice on / off
     lung_pressure_kpa: Annotated[float, Field(gt=0, le=4, allow_inf_nan=False)] = 0.8  # 8 cm H2O, speech at normal effort
-    glottal_area_voiced_cm2: Annotated[float, Field(gt=0, le=2, allow_inf_nan=False)] = 0.05  # its mean while voicing (mean flow about 180 cm^3/s)
     glottal_area_voiceless_cm2: Annotated[float, Field(gt=0, le=2, allow_inf_nan=False)] = 0.3  # abducted
     glottal_flow_peak_cm3_s: Annotated[float, Field(gt=0, le=2000, allow_inf_nan=False)] = 300.0  # the voice's AC flow
     # the paper's controller holds each target's forces ("static"); "pulse_step" opens each segment with a

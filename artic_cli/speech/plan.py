@@ -34,6 +34,7 @@ class Plan:
     lips: list[tuple[float, float]]  # (area cm^2, length cm)
     ports: list[float]
     voiced: np.ndarray
+    glottis_cm2: np.ndarray  # each segment's glottal opening: its own, else adducted (voiced) or abducted
     notes: list[str]  # per segment: how its forces were found
     solutions: list[str]  # the solution files ('' for given forces)
 
@@ -169,6 +170,9 @@ def plan(u: Utterance, cfg: Config, targets: list[TargetSpec | None], solve: Sol
         notes.append(note)
         files.append(str(path))
     starts = np.array(u.starts_ms()) / 1e3
+    open_ = cfg.speech.glottal_area_voiceless_cm2
+    glottis = np.array([s.glottis_cm2 if s.glottis_cm2 is not None else (vt.glottis_cm2 if s.voiced else open_)
+                        for s in u.segments], dtype=float)
     return Plan(labels=labels, starts_s=starts, durations_s=np.array([s.duration_ms for s in u.segments]) / 1e3,
                 forces_n=forces, lips=lips, ports=ports, voiced=np.array([s.voiced for s in u.segments]),
-                notes=notes, solutions=files)
+                glottis_cm2=glottis, notes=notes, solutions=files)

@@ -16,10 +16,10 @@ from typing import Callable
 import numpy as np
 
 from .. import units
-from ..acoustics.aerodynamics import Turbulence, turbulence
+from ..acoustics.aerodynamics import Turbulence
 from ..acoustics.analysis import analyse
 from ..acoustics.tube import Tube
-from ..acoustics.voice import Audio, synthesize_frames
+from ..acoustics.voice import Audio, Larynx, synthesize_speech
 from ..config import Config
 from ..errors import ArticError, NotPhysical
 from ..geometry.anatomy import TONGUE_MUSCLES
@@ -59,6 +59,7 @@ class Spoken:
     prepare_ms: float = 0.0  # the first segment's forces switch on this long before the sound (>= lead_ms)
     segment_lead_ms: np.ndarray = field(default_factory=lambda: np.zeros(0))  # (K,) each segment's own lead
     press: np.ndarray = field(default_factory=lambda: np.zeros(0))  # (K,) each segment's tongue-force factor
+    air: dict[str, np.ndarray] = field(default_factory=dict)  # per frame: the cavity's pressure, flows, voice gain
 
 
 @dataclass
@@ -193,13 +194,18 @@ def move(model: Model, c: Course, cfg: Config, lap: Laps, progress=None) -> tupl
 
 
 def tracts_of_run(u: Utterance, p: Plan, model: Model, traj: Trajectory, cfg: Config) -> Tracts:
-    """The tract of every frame: the lips and port of each segment's target, then the utterance's own course."""
+    """The tract of every frame: the lips and port of each segment's target (the config's before the first) and
+    each segment's glottis, then the utterance's own course."""
     vt = speaker_tract(cfg)
     shapes = shapes_of_model(model, traj.x, traj.time)
     lip_ramp = cfg.speech.lip_ramp_ms
     entries = [TractEntry(at_ms=float(s * 1e3), ramp_ms=lip_ramp if k else 0.0, lip_area_cm2=a, lip_length_cm=l,
                           velum_port_cm2=port)
-               for k, (s, (a, l), port) in enumerate(zip(p.starts_s, p.lips, p.ports))]
+               for k, (s, (a, l), port, solved) in enumerate(zip(p.starts_s, p.lips, p.ports, p.solutions))
+               if solved]  # a segment of given forces asks nothing of the lips and the port
+    voicing_ramp = cfg.speech.voicing_ramp_ms
+    entries += [TractEntry(at_ms=float(s * 1e3), ramp_ms=voicing_ramp if k else 0.0, glottis_cm2=float(g))
+                for k, (s, g) in enumerate(zip(p.starts_s, p.glottis_cm2))]
     return tracts_of(vt, cfg.speaker.wall, shapes, controls_for(vt, traj.time, entries + list(u.tract)))
 
 
@@ -219,23 +225,24 @@ def formant_tracks(tracts: Tracts, time_s: np.ndarray, cfg: Config) -> np.ndarra
 
 
 def sound(u: Utterance, p: Plan, tracts: Tracts, time_s: np.ndarray, duration_s: float, cfg: Config
-          ) -> tuple[Audio, Turbulence, np.ndarray]:
-    """The glottis and the air (voiced segments adduct it, voiceless ones open it), the turbulence noise at
-    the narrowest place, and the sound of the frames: (audio, turbulence, glottal area cm^2)."""
+          ) -> tuple[Audio, Turbulence, np.ndarray, dict[str, np.ndarray]]:
+    """The sound of the frames with the glottis, the port and the lungs of the course (voiceless segments
+    open the glottis, :func:`tracts_of_run`): (audio, the turbulence per frame, the glottal area cm^2, the
+    air per frame: the cavity's pressure, the flows, the voice's gain, the noise levels)."""
     sp, aco = cfg.speech, cfg.acoustics
     voicing = ramp_weights(p.starts_s, p.voiced.astype(float), units.ms_to_s(sp.voicing_ramp_ms), time_s)
-    glottis = sp.glottal_area_voiceless_cm2 + (sp.glottal_area_voiced_cm2 - sp.glottal_area_voiceless_cm2) * voicing
-    tb = turbulence(tracts.af.length_cm, tracts.af.area_cm2, glottis, units.kpa_to_cgs(sp.lung_pressure_kpa),
-                    aco.air_density_g_cm3, aco.air_viscosity_dyn_s_cm2, sp.noise.critical_reynolds, sp.noise.gain)
-    noise = None
-    if sp.noise.enabled:
-        noise = (tb.noise_rms_dyn_cm2, tb.at_cm / tracts.af.length_cm.sum(axis=1), sp.noise.seed)
-    amplitude = list(zip(time_s.tolist(), voicing.tolist()))
-    audio = synthesize_frames(tracts.af.length_cm, tracts.af.area_cm2, time_s, aco, duration_s,
-                              contour=[(float(a), float(b)) for a, b in u.f0_hz] if len(u.f0_hz) > 1 else None,
-                              f0_hz=float(u.f0_hz[0][1]), amplitude=amplitude,
-                              flow_peak_cm3_s=sp.glottal_flow_peak_cm3_s, noise=noise)
-    return audio, tb, glottis
+    glottis = tracts.controls["glottis_cm2"]
+    larynx = Larynx(glottis_cm2=glottis, port_cm2=tracts.controls["velum_port_cm2"],
+                    port_at_cm=float(np.mean(port_positions(tracts))),
+                    lung_pressure=units.kpa_to_cgs(sp.lung_pressure_kpa), voicing=voicing, noise=sp.noise,
+                    voiced_cm2=cfg.vocal_tract.glottis_cm2)
+    out = synthesize_speech(tracts.af.length_cm, tracts.af.area_cm2, time_s, aco, duration_s, larynx,
+                            contour=[(float(a), float(b)) for a, b in u.f0_hz] if len(u.f0_hz) > 1 else None,
+                            f0_hz=float(u.f0_hz[0][1]), flow_peak_cm3_s=sp.glottal_flow_peak_cm3_s)
+    air = out.air
+    tb = Turbulence(flow_cm3_s=air["constriction_flow"], reynolds=air["reynolds"], noise_rms_dyn_cm2=air["noise_rms"],
+                    at_cm=air["noise_at"], constriction_cm2=air["constriction"])
+    return out.audio, tb, glottis, air
 
 
 def speak_plan(u: Utterance, p: Plan, cfg: Config, model: Model, progress=None) -> Spoken:
@@ -250,12 +257,12 @@ def speak_plan(u: Utterance, p: Plan, cfg: Config, model: Model, progress=None) 
     lap("tract")
     formants_hz = formant_tracks(tracts, traj.time, cfg)
     lap("formant tracks")
-    audio, tb, glottis = sound(u, p, tracts, traj.time, c.duration_s, cfg)
+    audio, tb, glottis, air = sound(u, p, tracts, traj.time, c.duration_s, cfg)
     lap("sound")
     sp = cfg.speech
     commanded = np.array([c.force_at(float(t) + c.prep_s) for t in traj.time])
     return Spoken(utterance=u, plan=p, trajectory=traj, tracts=tracts, formants_hz=formants_hz, noise=tb,
-                  glottis_cm2=glottis, audio=audio,
+                  glottis_cm2=glottis, audio=audio, air=air,
                   control_points={name: traj.x[:, idx] for name, idx in model.control_points().items()},
                   muscle_names=list(model.muscle_names), muscle_force_n=units.dyn_to_newton(commanded),
                   timings_s=lap.times, segment_eps_cm=eps, beyond_wall_cm=beyond, force_course=c.how,

@@ -14,8 +14,9 @@ Example::
       - target: {name: a_open, jaw: {forces_n: {JO: 2.5}}, acoustic: {formants_hz: [753, 1385]}}   # inline
         duration_ms: 250
       - {forces_n: {JO: 1.0, GGp: 2.0}, duration_ms: 100, label: push}     # forces given, nothing solved
-    tract:                               # optional lip and velum course on top of the targets' lips
+    tract:                               # optional lip, velum and glottis course on top of the targets'
       - {at_ms: 250, ramp_ms: 40, lip_area_cm2: 0.0}
+      - {at_ms: 330, ramp_ms: 30, glottis_cm2: 0.3, velum_port_cm2: 0.5}
 
 A segment's ``lead_ms`` overrides the utterance's for its forces alone (a stop's closing gesture starts earlier,
 its release comes with the next segment's forces); ``press`` scales a solved target's tongue-muscle forces, up
@@ -43,7 +44,8 @@ class Segment(Strict):
     target: str | dict | None = None  # a target file, or a target inline
     forces_n: dict[str, ForceN] | None = None  # ... or the forces themselves (muscles, jaw units, groups)
     duration_ms: DurationMs
-    voiced: bool = True
+    voiced: bool = True  # the glottis adducted (vocal_tract.glottis_cm2) or abducted (speech.glottal_area_voiceless_cm2)
+    glottis_cm2: Annotated[float, Field(ge=0, le=2, allow_inf_nan=False)] | None = None  # ... or this opening
     label: SafeName | None = None  # the TextGrid's label (default: the target's name)
     lead_ms: Annotated[float, Field(ge=0, le=300, allow_inf_nan=False)] | None = None  # else the utterance's
     press: Annotated[float, Field(ge=1, le=3, allow_inf_nan=False)] = 1.0  # the target's tongue forces x this
@@ -86,6 +88,10 @@ class Utterance(Strict):
         total = self.duration_ms
         if total > MAX_UTTERANCE_MS:
             raise ValueError(f"the segments last {total:g} ms, above the {MAX_UTTERANCE_MS:g}-ms limit")
+        for k, e in enumerate(self.tract):
+            if e.at_ms >= total:
+                raise ValueError(f"tract[{k}].at_ms = {e.at_ms:g} is not inside the utterance (its segments end at "
+                                 f"{total:g} ms); move the entry or lengthen a segment")
         return self
 
     @property

@@ -56,6 +56,11 @@ def h5_path(wav: Path | str) -> Path:
     return Path(wav).with_suffix(".h5")
 
 
+AIR_UNITS = {"oral_pressure": "dyn/cm^2 (the cavity behind the narrowest place)", "glottal_flow": "cm^3/s",
+             "nasal_flow": "cm^3/s", "voice_gain": "0-1 (the voice's amplitude)",
+             "aspiration_rms": "dyn/cm^2 (the glottis's noise source)", "nose_cm2": "cm^2 (the nose's outlet)"}
+
+
 def write(wav: Path | str, s: Spoken, prov=None) -> dict[str, Path]:
     """The WAV, the TextGrid, then the HDF5 record (last: it is what says the three are up to date)."""
     write_wav(wav, s.audio)
@@ -113,6 +118,9 @@ def write(wav: Path | str, s: Spoken, prov=None) -> dict[str, Path]:
         n.create_dataset("noise_rms", data=s.noise.noise_rms_dyn_cm2).attrs["units"] = "dyn/cm^2"
         n.create_dataset("constriction", data=s.noise.constriction_cm2).attrs["units"] = "cm^2"
         n.create_dataset("noise_at", data=s.noise.at_cm).attrs["units"] = "cm from the glottis"
+        for name, unit in AIR_UNITS.items():
+            if name in s.air:
+                n.create_dataset(name, data=s.air[name]).attrs["units"] = unit
         f.create_dataset("volume_change", data=s.trajectory.volume_change).attrs["units"] = "fraction"
         f.create_dataset("inverted_bricks", data=s.trajectory.inverted)
         if s.trajectory.contact_count is not None:

@@ -51,6 +51,7 @@ def write(path: Path | str, t: Tracts, prov: Provenance | None = None, extra: di
         for name, data, unit in [("time", t.time_s, "s"), ("length_cm", af.length_cm, "cm"),
                                  ("area_cm2", af.area_cm2, "cm^2"), ("tract_length_cm", af.tract_length_cm, "cm"),
                                  ("velum_port_cm2", t.controls["velum_port_cm2"], "cm^2"),
+                                 ("glottis_cm2", t.controls["glottis_cm2"], "cm^2"),
                                  ("lips/area_cm2", t.controls["lip_area_cm2"], "cm^2"),
                                  ("lips/length_cm", t.controls["lip_length_cm"], "cm"),
                                  ("section_region", af.region, "index into region_names"),
@@ -85,7 +86,7 @@ def read(path: Path | str) -> Tracts:
             grid = Grid(origin=f["grid/origin_cm"][()], normal=f["grid/normal"][()], arc_cm=f["grid/arc_cm"][()],
                         region=af.region[:f["grid/origin_cm"].shape[0]], reach_cm=float("nan"))
             controls = {"velum_port_cm2": f["velum_port_cm2"][()], "lip_area_cm2": f["lips/area_cm2"][()],
-                        "lip_length_cm": f["lips/length_cm"][()]}
+                        "lip_length_cm": f["lips/length_cm"][()], "glottis_cm2": f["glottis_cm2"][()]}
             contours = {k: v[()] for k, v in f["contours"].items() if k != "fixed"}
             fixed = {k: v[()] for k, v in f["contours/fixed"].items()}
             band = f["band/area_cm2"][()] if "band" in f else None

@@ -1,4 +1,5 @@
-"""The tract's control inputs frame by frame: the lip tube (area, length) and the velopharyngeal port."""
+"""The tract's control inputs frame by frame: the lip tube (area, length), the velopharyngeal port and the
+glottis's mean opening."""
 
 from __future__ import annotations
 
@@ -10,8 +11,9 @@ from ..validation import check_number
 
 
 def default_controls(vt: VocalTract) -> dict[str, float]:
-    """The config's lip tube and port (cm^2, cm)."""
-    return {"lip_area_cm2": vt.lips.area_cm2, "lip_length_cm": vt.lips.length_cm, "velum_port_cm2": vt.velum_port_cm2}
+    """The config's lip tube, port and glottis (cm^2, cm)."""
+    return {"lip_area_cm2": vt.lips.area_cm2, "lip_length_cm": vt.lips.length_cm, "velum_port_cm2": vt.velum_port_cm2,
+            "glottis_cm2": vt.glottis_cm2}
 
 
 def controls_for(vt: VocalTract, time_s: np.ndarray, entries: list[TractEntry] | None = None,

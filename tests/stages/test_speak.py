@@ -227,10 +227,12 @@ def test_an_alveolar_channel_makes_s_frication_20_db_above_the_vowels(tmp_path, 
 
 def test_a_narrow_channel_makes_frication_that_the_noise_switch_removes(spoken, mesh_file, tmp_path):
     """The lip channel of 0.08 cm^2 (450-600 ms): Praat hears the band above 3 kHz 20 dB louder than the same
-    utterance without the noise source, and louder than the open vowel's there."""
+    utterance without the noise sources (the frication at the channel and the aspiration at the open glottis),
+    and louder than the open vowel's there."""
     fric = praat_level_db(spoken / "lab.wav", 0.49, 0.58, 3000.0)
     d = yaml.safe_load((ROOT / "configs" / "default.yaml").read_text())
     d["speech"] = {"noise": {"enabled": False}}
+    d.setdefault("acoustics", {})["sources"] = {"aspiration": False}
     cfg = _write(tmp_path / "quiet.yaml", d)
     res = _run("speak", spoken / "lab.yaml", "--mesh", mesh_file, "--config", cfg, "--out", tmp_path / "quiet.wav")
     assert res.exit_code == 0, res.output
@@ -362,6 +364,7 @@ def test_a_segment_s_own_lead_moves_its_forces_alone_and_press_scales_only_the_t
                          "lead_ms": 0, "prepare_ms": 0, "ramp_ms": 0})
     plan = Plan(labels=["k"], starts_s=np.array([0.0]), durations_s=np.array([0.06]),
                       forces_n=[{"JO": 1.0, "SG": 2.0}], lips=[(3.0, 1.0)], ports=[0.0], voiced=np.array([False]),
+                      glottis_cm2=np.array([0.3]),
                       notes=["solved"], solutions=[""])
     m = mesh_stage.read(mesh_file, cfg)
     said = speak.compute(u, plan, cfg, m.mesh, m.wall)
