@@ -44,6 +44,7 @@ def main() -> None:
     compute_frames(lengths[:2], areas[:2], times[:2], cfg, 0.05)  # compile (or load) the line
     syn = median_time(lambda: compute_frames(lengths, areas, times, cfg, 1.0), n=3)
     print(f"1 s of audio (44.1 kHz) from 200 frames: {syn:.2f} s (goal <= 1 s: {'met' if syn <= 1.0 else 'NOT met'})")
+    speech_synthesis(cfg, lengths, areas, times)
     try:
         import vocaltractlab_cython as vtl
     except ImportError:
@@ -53,6 +54,25 @@ def main() -> None:
     theirs = median_time(lambda: vtl.tract_state_to_transfer_function(shape, n_spectrum_samples=2048))
     print(f"VocalTractLab, one transfer function (its default, 2048-point spectrum): {theirs * 1e3:.2f} ms; "
           f"ours / theirs = {one / theirs:.2f}")
+
+
+def speech_synthesis(cfg, lengths, areas, times) -> None:
+    """The speaking synthesis with every source (issue 44): the air in time, aspiration, bursts, the voice
+    bar, and the nasal branch with the port shut and open the whole second.  Goal: at most 0.1 s per second
+    of audio on one core."""
+    from artic_cli import units
+    from artic_cli.acoustics.voice import Larynx, synthesize_speech
+
+    def larynx(port_cm2: float, frames: int = len(times)) -> Larynx:
+        return Larynx(glottis_cm2=np.full(frames, 0.05), port_cm2=np.full(frames, port_cm2),
+                      port_at_cm=8.5, lung_pressure=units.kpa_to_cgs(0.8), voicing=np.ones(frames),
+                      noise=cfg.speech.noise, voiced_cm2=0.05)
+
+    synthesize_speech(lengths[:2], areas[:2], times[:2], cfg.acoustics, 0.05, larynx(0.5, 2))  # compile or load
+    for port in (0.0, 0.5):
+        took = median_time(lambda: synthesize_speech(lengths, areas, times, cfg.acoustics, 1.0, larynx(port)), n=3)
+        print(f"1 s of speech with every source, the port {'open 0.5 cm^2' if port else 'shut'}: {took:.3f} s "
+              f"(goal <= 0.1 s per s of audio: {'met' if took <= 0.1 else 'NOT met'})")
 
 
 if __name__ == "__main__":

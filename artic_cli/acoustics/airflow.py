@@ -11,7 +11,7 @@ what lets voicing go on behind a closure; Stevens 1998, ch. 2.1-2.2, for the mod
 
     V / (rho c^2) dP/dt = U_g - U_c - U_n - S x'.
 
-Each step is backward Euler for P (found by bisection: the right side falls as P rises, so one root) with the
+Each step is backward Euler for P (Newton inside a bisection bracket: the right side falls as P rises, so one root) with the
 wall's velocity solved with it; the step is a few of the line's samples (the cavity's time constant at a
 release is about a millisecond).  With the constriction closed, P rises toward P_s and the flow through the
 glottis, and with it the voice, dies away; at the release P drives a burst of flow through the opening.
@@ -52,20 +52,41 @@ def cavities(length_cm: np.ndarray, area_cm2: np.ndarray) -> Cavity:
                   wall_cm2=wall, end=np.maximum(end, k))
 
 
-def line_cavities(frame_areas: np.ndarray, section_cm: float, frame_index: np.ndarray, chunk: int = 4096) -> Cavity:
+@njit(cache=True)
+def _line_cavities(frame_areas, section_cm, frame_index):  # pragma: no cover - compiled
+    steps, (F, n) = frame_index.shape[0], frame_areas.shape
+    index, end = np.zeros(steps, np.int64), np.zeros(steps, np.int64)
+    area, volume, wall = np.zeros(steps), np.zeros(steps), np.zeros(steps)
+    a = np.zeros(n)
+    for s in range(steps):
+        k0 = min(int(frame_index[s]), max(F - 2, 0))
+        w = frame_index[s] - k0 if F > 1 else 0.0
+        for j in range(n):
+            a[j] = (1.0 - w) * frame_areas[k0, j] + (w * frame_areas[k0 + 1, j] if F > 1 else 0.0)
+        k = 0
+        for j in range(1, n):
+            if a[j] < a[k]:
+                k = j
+        v, surface = 0.0, 0.0
+        for j in range(k):
+            v += section_cm * a[j]
+            surface += section_cm * 2.0 * np.sqrt(np.pi * max(a[j], 0.0))
+        e = k
+        while e + 1 < n and a[e + 1] <= 1.5 * a[k] + 1e-4:
+            e += 1
+        index[s], end[s], area[s], volume[s], wall[s] = k, e, a[k], v, surface
+    return index, end, area, volume, wall
+
+
+def line_cavities(frame_areas: np.ndarray, section_cm: float, frame_index: np.ndarray) -> Cavity:
     """The cavity at each of the air's steps from the line's own areas (frames x equal sections of
     ``section_cm``), interpolated between frames at fractional ``frame_index`` as the line does: the narrowest
-    place moves with the areas, not from one frame's to the next's."""
-    F, n = frame_areas.shape
-    out = []
-    for start in range(0, len(frame_index), chunk):
-        pos = np.asarray(frame_index[start:start + chunk], float)
-        k0 = np.clip(pos.astype(int), 0, max(F - 2, 0))
-        w = (pos - k0)[:, None] if F > 1 else np.zeros((len(pos), 1))
-        a = (1.0 - w) * frame_areas[k0] + (w * frame_areas[np.minimum(k0 + 1, F - 1)] if F > 1 else 0.0)
-        out.append(cavities(np.full(a.shape, section_cm), a))
-    return Cavity(*(np.concatenate([getattr(c, f) for c in out]) for f in
-                    ("index", "area_cm2", "at_cm", "volume_cm3", "wall_cm2", "end")))
+    place moves with the areas, not from one frame's to the next's (the same numbers as :func:`cavities` on
+    the interpolated areas; a test compares)."""
+    index, end, area, volume, wall = _line_cavities(np.ascontiguousarray(frame_areas, dtype=float), float(section_cm),
+                                                    np.ascontiguousarray(frame_index, dtype=float))
+    return Cavity(index=index, area_cm2=area, at_cm=(index + 1) * section_cm, volume_cm3=volume, wall_cm2=wall,
+                  end=end)
 
 
 def outlet(index: np.ndarray, area_cm2: np.ndarray, constricted_cm2: float) -> np.ndarray:
@@ -86,6 +107,12 @@ def _orifice(area, dp, rho):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
+def _slope(area, dp, rho):  # pragma: no cover - compiled
+    """d|U| / d|dp| of an orifice (large near dp = 0, where Bernoulli's flow is not smooth)."""
+    return area / np.sqrt(2.0 * rho * max(abs(dp), 1e-3))
+
+
+@njit(cache=True)
 def _cavity_pressure(lung, glottis, constriction, nose, compliance, wall_area, wall_m, wall_r, wall_k, rho,
                      dt):  # pragma: no cover - compiled
     """(P, U_g, U_c, U_n) per step: P the cavity's pressure (dyn/cm^2), the flows cm^3/s."""
@@ -98,15 +125,24 @@ def _cavity_pressure(lung, glottis, constriction, nose, compliance, wall_area, w
         c_dt = compliance[s] / dt
         lo = -2.0 * lung - abs(p)
         hi = 2.0 * lung + abs(p)
-        for _ in range(48):  # bisection: the net inflow falls as P rises
-            mid = 0.5 * (lo + hi)
-            net = (_orifice(glottis[s], lung - mid, rho) - _orifice(constriction[s], mid, rho)
-                   - _orifice(nose[s], mid, rho) - wall_area[s] * (a + mid / d))
-            if c_dt * (mid - p) < net:
-                lo = mid
+        x_ = p  # Newton from the last step's pressure, kept inside a bisection bracket (the residual rises with P)
+        for _ in range(60):
+            r = c_dt * (x_ - p) - (_orifice(glottis[s], lung - x_, rho) - _orifice(constriction[s], x_, rho)
+                                   - _orifice(nose[s], x_, rho) - wall_area[s] * (a + x_ / d))
+            if r < 0.0:
+                lo = x_
             else:
-                hi = mid
-        p = 0.5 * (lo + hi)
+                hi = x_
+            slope = c_dt + wall_area[s] / d + _slope(glottis[s], lung - x_, rho) + _slope(constriction[s], x_, rho) \
+                + _slope(nose[s], x_, rho)
+            step = x_ - r / slope
+            if not (lo < step < hi):
+                step = 0.5 * (lo + hi)
+            if abs(step - x_) < 1e-6 * (1.0 + abs(x_)) or hi - lo < 1e-6:
+                x_ = step
+                break
+            x_ = step
+        p = x_
         v = a + p / d
         x += dt * v
         p_out[s] = p

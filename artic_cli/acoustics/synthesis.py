@@ -74,9 +74,9 @@ def _branch_step(branch_areas, bf, bb, new_bf, new_bb, keep):  # pragma: no cove
 
 
 @njit(cache=True)
-def _lips_reflect(a_l, f_now, last_f, last_b, rho, c, fs):  # pragma: no cover - compiled
-    """The wave reflected at the lips: the radiation load, a parallel R-L (Flanagan), by the bilinear
-    transform of its reflection filter, from the forward wave now and the last sample's two waves."""
+def _radiation(a_l, rho, c, fs):  # pragma: no cover - compiled
+    """(b0, b1, a0, a1): the reflection filter of an opening of area ``a_l`` into the radiation load, a
+    parallel R-L (Flanagan), by the bilinear transform."""
     pi = np.pi
     zc = rho * c / a_l
     r_rad = 128.0 * rho * c / (9.0 * pi * pi * a_l)
@@ -85,6 +85,13 @@ def _lips_reflect(a_l, f_now, last_f, last_b, rho, c, fs):  # pragma: no cover -
     b1 = -k_rad * (r_rad - zc) - zc * r_rad
     a0 = k_rad * (r_rad + zc) + zc * r_rad
     a1 = -k_rad * (r_rad + zc) + zc * r_rad
+    return b0, b1, a0, a1
+
+
+@njit(cache=True)
+def _lips_reflect(a_l, f_now, last_f, last_b, rho, c, fs):  # pragma: no cover - compiled
+    """The wave reflected at the lips from the forward wave now and the last sample's two waves."""
+    b0, b1, a0, a1 = _radiation(a_l, rho, c, fs)
     return (b0 * f_now + b1 * last_f - a1 * last_b) / a0
 
 
@@ -100,54 +107,48 @@ def _value_at(frame_values, pos):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _shunted(into, a_sum, rho_c, areas, cs, ds):  # pragma: no cover - compiled
-    """A junction's pressure (dyn/cm^2) with shunts that each take area x velocity, a velocity (c + p) / d
-    (backward Euler on m dv/dt = p - r v - k x: c = m v / dt - k x, d = m / dt + r + k dt)."""
-    num = into
-    den = a_sum
-    for i in range(areas.shape[0]):
-        if areas[i] > 0.0:
-            num -= areas[i] * cs[i] / ds[i]
-            den += rho_c * areas[i] / ds[i]
-    return rho_c * num / den
-
-
-@njit(cache=True)
-def _nasal_step(nl_areas, sinus_at, sinus_m, sinus_k, sinus_a, nf, nb, new_nf, new_nb, sv, sx, wv, wx,
-                wall, keep, dt, dx, rho, c, fs, nostril, rad):  # pragma: no cover - compiled
+def _nasal_step(nl_areas, patch, sinus_at, sinus_m, sinus_k, sinus_a, nf, nb, new_nf, new_nb, sv, sx, wv, wx,
+                wall, keep, dt, rho, c, rad):  # pragma: no cover - compiled
     """One sample of the nasal branch (``new_nf[0]`` set by the caller): its junctions with their yielding
-    walls and sinuses, the nostrils radiating; returns the nostrils' volume velocity."""
+    walls (``patch``: each junction's wall area) and sinuses, the nostrils radiating (``rad``: the filter's
+    last two waves and its coefficients); returns the nostrils' volume velocity.  A junction's pressure and
+    its shunts' velocities are solved together: each shunt (a wall patch, a sinus's neck) of area A moves at
+    v = (c + p) / d (backward Euler on m dv/dt = p - r v - k x: c = m v / dt - k x, d = m / dt + r + k dt), so
+    p = rho c (into - sum A c / d) / (sum of areas + rho c sum A / d)."""
     m = nl_areas.shape[0]
     rho_c = rho * c
-    sh_a, sh_c, sh_d = np.zeros(2), np.zeros(2), np.ones(2)
+    walls = wall[0] > 0.0
+    inv_dw = 1.0 / (wall[0] / dt + wall[1] + wall[2] * dt) if walls else 0.0
     for k in range(m - 1):
         a_sum = nl_areas[k] + nl_areas[k + 1]
-        into = 2.0 * (nl_areas[k] * nf[k] + nl_areas[k + 1] * nb[k + 1])
-        sh_a[0] = 0.0
-        sh_a[1] = 0.0
-        if wall[0] > 0.0:
-            sh_a[0] = 2.0 * np.sqrt(np.pi * 0.5 * a_sum) * dx
-            sh_c[0] = (wall[0] / dt) * wv[k] - wall[2] * wx[k]
-            sh_d[0] = wall[0] / dt + wall[1] + wall[2] * dt
+        num = 2.0 * (nl_areas[k] * nf[k] + nl_areas[k + 1] * nb[k + 1])
+        den = a_sum
+        cw = 0.0
+        if walls:
+            cw = (wall[0] / dt) * wv[k] - wall[2] * wx[k]
+            num -= patch[k] * cw * inv_dw
+            den += rho_c * patch[k] * inv_dw
         q = sinus_at[k]
+        cs, inv_ds = 0.0, 0.0
         if q >= 0:
-            sh_a[1] = sinus_a[q]
-            sh_c[1] = (sinus_m[q] / dt) * sv[q] - sinus_k[q] * sx[q]
-            sh_d[1] = sinus_m[q] / dt + sinus_k[q] * dt
-        p = _shunted(into, a_sum, rho_c, sh_a, sh_c, sh_d)
-        if sh_a[0] > 0.0:
-            wv[k] = (sh_c[0] + p) / sh_d[0]
+            cs = (sinus_m[q] / dt) * sv[q] - sinus_k[q] * sx[q]
+            inv_ds = 1.0 / (sinus_m[q] / dt + sinus_k[q] * dt)
+            num -= sinus_a[q] * cs * inv_ds
+            den += rho_c * sinus_a[q] * inv_ds
+        p = rho_c * num / den
+        if walls:
+            wv[k] = (cw + p) * inv_dw
             wx[k] += dt * wv[k]
         if q >= 0:
-            sv[q] = (sh_c[1] + p) / sh_d[1]
+            sv[q] = (cs + p) * inv_ds
             sx[q] += dt * sv[q]
         pj = p / rho_c
         new_nf[k + 1] = pj - nb[k + 1]
         new_nb[k] = pj - nf[k]
-    new_nb[m - 1] = _lips_reflect(nostril, nf[m - 1], rad[0], rad[1], rho, c, fs)
+    new_nb[m - 1] = (rad[2] * nf[m - 1] + rad[3] * rad[0] - rad[5] * rad[1]) / rad[4]  # the nostrils' radiation
     rad[0] = nf[m - 1]
     rad[1] = new_nb[m - 1]
-    u = nostril * (nf[m - 1] - new_nb[m - 1])
+    u = rad[6] * (nf[m - 1] - new_nb[m - 1])
     for k in range(m):
         nf[k] = keep * new_nf[k]
         nb[k] = keep * new_nb[k]
@@ -167,7 +168,12 @@ def _line(frame_areas, frame_index, source, glottal_reflection, rho, c, fs, loss
     nm = nasal_areas.shape[0]
     nas = nasal_areas.copy()
     nf, nb, new_nf, new_nb = np.zeros(nm), np.zeros(nm), np.zeros(nm), np.zeros(nm)  # the nasal branch
-    nwv, nwx, sv, sx, rad = np.zeros(nm), np.zeros(nm), np.zeros(len(sinus_a)), np.zeros(len(sinus_a)), np.zeros(2)
+    nwv, nwx, sv, sx, rad = np.zeros(nm), np.zeros(nm), np.zeros(len(sinus_a)), np.zeros(len(sinus_a)), np.zeros(7)
+    rad[2], rad[3], rad[4], rad[5] = _radiation(nostril, rho, c, fs)  # the nostrils' filter; rad[:2]: its waves
+    rad[6] = nostril
+    npatch = np.zeros(max(nm - 1, 0))  # the nasal junctions' wall areas (those beside the port: per sample)
+    for k in range(nm - 1):
+        npatch[k] = 2.0 * np.sqrt(np.pi * 0.5 * (nas[k] + nas[k + 1])) * (c / fs)
     out = np.zeros(n_samples)
     last_u, last_f, last_b = 0.0, 0.0, 0.0
     keep = 1.0 - loss
@@ -185,6 +191,8 @@ def _line(frame_areas, frame_index, source, glottal_reflection, rho, c, fs, loss
         nasal = port > MIN_AREA_CM2
         if nasal:
             nas[:nasal_port] = port
+            for k in range(min(nasal_port, nm - 1)):
+                npatch[k] = 2.0 * np.sqrt(np.pi * 0.5 * (nas[k] + nas[k + 1])) * dx
         new_f[0] = glottal_reflection * bwd[0] + source[s] / area[0]
         skin_u = 0.0
         for j in range(n - 1):  # each junction's pressure p / (rho c) = f + b from the flows U = A (f - b) into it
@@ -227,12 +235,14 @@ def _line(frame_areas, frame_index, source, glottal_reflection, rho, c, fs, loss
             _branch_step(branch_areas, bf, bb, new_bf, new_bb, keep)
         u_nose = 0.0
         if nasal:
-            u_nose = _nasal_step(nas, sinus_at, sinus_m, sinus_k, sinus_a, nf, nb, new_nf, new_nb, sv, sx, nwv,
-                                 nwx, wall, keep, dt, dx, rho, c, fs, nostril, rad)
+            u_nose = _nasal_step(nas, npatch, sinus_at, sinus_m, sinus_k, sinus_a, nf, nb, new_nf, new_nb, sv, sx,
+                                 nwv, nwx, wall, keep, dt, rho, c, rad)
             was_open = True
         elif was_open:  # the port shut: the nasal tract's air column is cut off, its waves gone
-            for arr in (nf, nb, nwv, nwx, sv, sx, rad):
+            for arr in (nf, nb, nwv, nwx, sv, sx):
                 arr[:] = 0.0
+            rad[0] = 0.0
+            rad[1] = 0.0
             was_open = False
         a_l = area[n - 1]
         new_b[n - 1] = _lips_reflect(a_l, fwd[n - 1], last_f, last_b, rho, c, fs)

@@ -139,15 +139,21 @@ class _Air:
     nose_cm2: np.ndarray
 
 
-def _air(areas: np.ndarray, index: np.ndarray, section_cm: float, larynx: Larynx, ac) -> _Air:
+def _air(areas: np.ndarray, index: np.ndarray, section_cm: float, narrowest_cm2: np.ndarray, larynx: Larynx,
+         ac) -> _Air:
     """The cavity behind the line's narrowest place and its air, step by step (:mod:`.airflow`), or with
     ``ac.sources.bursts`` off, the quasi-steady flow of the lungs' pressure through the glottis and the
-    constriction in series."""
+    constriction in series.  The constriction's area is each frame's own narrowest (``narrowest_cm2``,
+    between frames linear): the line's sections, 0.4 cm long, sample a short channel at their centres and
+    would widen it."""
+    from dataclasses import replace
+
     from .aerodynamics import flow
     from .airflow import airflow, line_cavities
 
+    frames = np.arange(len(narrowest_cm2))
     cav = line_cavities(areas, section_cm, index)
-    frames = np.arange(len(larynx.glottis_cm2))
+    cav = replace(cav, area_cm2=np.interp(index, frames, narrowest_cm2))
     glottis = np.interp(index, frames, larynx.glottis_cm2)
     port = np.interp(index, frames, larynx.port_cm2)
     nose = _nose_cm2(port, ac, cav.at_cm <= larynx.port_at_cm)
@@ -182,7 +188,7 @@ def synthesize_speech(lengths_cm: np.ndarray, areas_cm2: np.ndarray, times_s: np
     index = np.interp(t, times, np.arange(len(times))) if len(times) > 1 else np.zeros(len(t))
     stride = AIR_STRIDE
     larynx.step_s = stride / fs
-    air = _air(areas, index[::stride], mean_length / n, larynx, ac)
+    air = _air(areas, index[::stride], mean_length / n, np.asarray(areas_cm2, float).min(axis=1), larynx, ac)
     steps = np.arange(0, len(t), stride)
     up = lambda v: np.interp(np.arange(len(t)), steps, v)  # noqa: E731 - the air's steps to every sample
     cav = air.cavity
@@ -195,9 +201,13 @@ def synthesize_speech(lengths_cm: np.ndarray, areas_cm2: np.ndarray, times_s: np
                           units.kpa_to_cgs(so.phonation_threshold_kpa), larynx.voiced_cm2, so.voicing_stops_at_cm2)
     else:
         gain = np.interp(t[steps], times, larynx.voicing)
-    place = np.repeat(np.clip(cav.index, 0, n - 2), stride)[:len(t)]
-    rng = np.random.default_rng(nz.seed)
-    p_noise = up(frication) * rng.standard_normal(len(t))
+    # the jet's noise just past the narrowest place, each frame's own (the line's sections could put it behind
+    # a short channel, where the constriction filters it away)
+    from .airflow import cavities
+
+    frame_cav = cavities(lengths_cm, areas_cm2)
+    unit, place = noise_samples(times, np.ones(len(times)), frame_cav.at_cm / lengths_cm.sum(axis=1), t, n, nz.seed)
+    p_noise = up(frication) * unit
     extra = Extra(voice_gain=up(gain), skin=1.0 if so.voice_bar and ac.yielding_walls else 0.0)
     if so.aspiration:
         extra.aspiration = up(asp) * np.random.default_rng(so.seed).standard_normal(len(t))
@@ -220,7 +230,7 @@ def synthesize_speech(lengths_cm: np.ndarray, areas_cm2: np.ndarray, times_s: np
               "constriction_flow": at_frames(air.constriction), "nasal_flow": at_frames(air.nasal),
               "voice_gain": at_frames(gain), "aspiration_rms": at_frames(asp), "noise_rms": at_frames(frication),
               "reynolds": reynolds(at_frames(air.constriction), at_frames(cav.area_cm2), rho, mu),
-              "noise_at": at_frames((cav.index + 1) * (mean_length / n)), "constriction": at_frames(cav.area_cm2),
+              "noise_at": frame_cav.at_cm, "constriction": at_frames(cav.area_cm2),
               "nose_cm2": at_frames(air.nose_cm2)}
     return Sounded(Audio(0.9 * y / peak if peak > 0 else y, sy.sample_rate_hz), record)
 

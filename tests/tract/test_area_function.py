@@ -60,14 +60,17 @@ def test_a_tongue_through_the_wall_reads_a_closure_and_a_missing_contour_reads_n
 
 
 def test_tract_controls_follow_a_smooth_ramp():
-    start = {"lip_area_cm2": 3.0, "lip_length_cm": 1.0, "velum_port_cm2": 0.0}
+    start = {"lip_area_cm2": 3.0, "lip_length_cm": 1.0, "velum_port_cm2": 0.0, "glottis_cm2": 0.05}
     t = np.linspace(0.0, 0.3, 301)
-    c = tract_controls([TractEntry(at_ms=100, ramp_ms=60, lip_area_cm2=0.5)], start, t)
+    c = tract_controls([TractEntry(at_ms=100, ramp_ms=60, lip_area_cm2=0.5),
+                        TractEntry(at_ms=200, ramp_ms=20, glottis_cm2=0.3)], start, t)
     a = c["lip_area_cm2"]
     assert (a[t < 0.1] == 3.0).all() and (a[t >= 0.16] == pytest.approx(0.5))
     assert a[np.argmin(abs(t - 0.13))] == pytest.approx(1.75, abs=1e-9)  # half-way at half the ramp
     assert (np.diff(a) <= 1e-12).all()  # monotone, no overshoot
     assert (c["velum_port_cm2"] == 0.0).all() and (c["lip_length_cm"] == 1.0).all()
+    g = c["glottis_cm2"]  # the glottis is a control like the others: held, then ramped to its new opening
+    assert (g[t < 0.2] == 0.05).all() and g[np.argmin(abs(t - 0.21))] == pytest.approx(0.175) and g[-1] == 0.3
 
 
 def test_the_band_area_of_a_uniform_slab_is_its_width_times_its_depth(cfg):
