@@ -106,7 +106,7 @@ def _value_at(frame_values, pos):  # pragma: no cover - compiled
     return (1.0 - w) * frame_values[k0] + w * frame_values[k0 + 1]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _nasal_step(nl_areas, patch, sinus_at, sinus_m, sinus_k, sinus_a, nf, nb, new_nf, new_nb, sv, sx, wv, wx,
                 wall, keep, dt, rho, c, rad):  # pragma: no cover - compiled
     """One sample of the nasal branch (``new_nf[0]`` set by the caller): its junctions with their yielding
@@ -155,13 +155,74 @@ def _nasal_step(nl_areas, patch, sinus_at, sinus_m, sinus_k, sinus_a, nf, nb, ne
     return u
 
 
+@njit(cache=True, inline="always")
+def _junctions(area, fwd, bwd, new_f, new_b, wall_x, wall_v, wall, rho, c, dt, dx, branch_at, branch_areas, bb,
+               new_bf, nasal_at, port, nb, new_nf, inject, inject_at):  # pragma: no cover - compiled
+    """Each junction's pressure p / (rho c) = f + b from the flows U = A (f - b) into it, the side branches'
+    (the fossa at ``branch_at``, the nasal tract through the port at ``nasal_at``, -1: shut) and an injected
+    flow joining; the walls' patches solved with it.  Returns the walls' volume velocity."""
+    n = area.shape[0]
+    wall_m, wall_r, wall_k = wall[0], wall[1], wall[2]
+    walls = wall_m > 0.0
+    pi = np.pi
+    skin = 0.0
+    for j in range(n - 1):
+        a_sum = area[j] + area[j + 1]
+        into = 2.0 * (area[j] * fwd[j] + area[j + 1] * bwd[j + 1])
+        if j == inject_at:  # the air leaving a constriction as it opens (a release's transient)
+            into += inject
+        main = a_sum
+        if j == nasal_at:  # the port: the nasal branch's flow joins
+            a_sum += port
+            into += 2.0 * port * nb[0]
+        if j == branch_at:  # three tubes meet: the side branch's flow joins
+            a_sum += branch_areas[0]
+            into += 2.0 * branch_areas[0] * bb[0]
+        elif walls:  # less what the junction's wall patch takes; the wall's velocity and the pressure solved
+            # together (backward Euler): stable for any area, a closure's slit included
+            patch = 2.0 * np.sqrt(pi * 0.5 * main) * dx
+            wall_v[j] = ((wall_m / dt) * wall_v[j] + rho * c * into / a_sum - wall_k * wall_x[j]) / (
+                wall_m / dt + rho * c * patch / a_sum + wall_r + wall_k * dt)
+            wall_x[j] += dt * wall_v[j]
+            into -= patch * wall_v[j]
+            skin += patch * wall_v[j]
+        pj = into / a_sum
+        new_f[j + 1] = pj - bwd[j + 1]
+        new_b[j] = pj - fwd[j]
+        if j == branch_at:
+            new_bf[0] = pj - bb[0]
+        if j == nasal_at:
+            new_nf[0] = pj - nb[0]
+    return skin
+
+
+@njit(cache=True, inline="always")
+def _pressure_source(new_f, new_b, p, k, rho, c):  # pragma: no cover - compiled
+    """A series pressure source (dyn/cm^2) between sections k and k + 1: half its pressure sent each way."""
+    half = 0.5 * p / (rho * c)
+    new_f[k + 1] += half
+    new_b[k] -= half
+
+
+@njit(cache=True, inline="always")
+def _advance(area, fwd, bwd, new_f, new_b, keep):  # pragma: no cover - compiled
+    """The new waves, less the sections' loss; a closed section holds no air column: no wave stays trapped in
+    it to leave as a click when it opens (its flow A (f - b) would jump with its area)."""
+    for j in range(area.shape[0]):
+        if area[j] <= MIN_AREA_CM2:
+            fwd[j] = 0.0
+            bwd[j] = 0.0
+        else:
+            fwd[j] = keep * new_f[j]
+            bwd[j] = keep * new_b[j]
+
+
 @njit(cache=True)
 def _line(frame_areas, frame_index, source, glottal_reflection, rho, c, fs, loss, branch_at,
           branch_areas, noise, noise_at, wall_m, wall_r, wall_k, nasal_at, nasal_areas, nasal_port,
           frame_ports, sinus_at, sinus_m, sinus_k, sinus_a, nostril, aspiration, inject, inject_at,
           skin):  # pragma: no cover - compiled
-    n_samples = source.shape[0]
-    n = frame_areas.shape[1]
+    n_samples, n = source.shape[0], frame_areas.shape[1]
     fwd, bwd, new_f, new_b, area = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
     m = branch_areas.shape[0]
     bf, bb, new_bf, new_bb = np.zeros(m), np.zeros(m), np.zeros(m), np.zeros(m)  # the fossa: away, toward
@@ -171,19 +232,15 @@ def _line(frame_areas, frame_index, source, glottal_reflection, rho, c, fs, loss
     nwv, nwx, sv, sx, rad = np.zeros(nm), np.zeros(nm), np.zeros(len(sinus_a)), np.zeros(len(sinus_a)), np.zeros(7)
     rad[2], rad[3], rad[4], rad[5] = _radiation(nostril, rho, c, fs)  # the nostrils' filter; rad[:2]: its waves
     rad[6] = nostril
+    dt, dx = 1.0 / fs, c / fs
     npatch = np.zeros(max(nm - 1, 0))  # the nasal junctions' wall areas (those beside the port: per sample)
     for k in range(nm - 1):
-        npatch[k] = 2.0 * np.sqrt(np.pi * 0.5 * (nas[k] + nas[k + 1])) * (c / fs)
+        npatch[k] = 2.0 * np.sqrt(np.pi * 0.5 * (nas[k] + nas[k + 1])) * dx
     out = np.zeros(n_samples)
     last_u, last_f, last_b = 0.0, 0.0, 0.0
     keep = 1.0 - loss
-    pi = np.pi
-    wall_x = np.zeros(n)  # each junction's wall patch: displacement (cm) and velocity (cm/s)
-    wall_v = np.zeros(n)
-    walls = wall_m > 0.0
+    wall_x, wall_v = np.zeros(n), np.zeros(n)  # each junction's wall patch: displacement (cm), velocity (cm/s)
     wall = np.array([wall_m, wall_r, wall_k])
-    dt = 1.0 / fs
-    dx = c / fs
     was_open = False
     for s in range(n_samples):
         _areas_at(frame_areas, frame_index[s], area)
@@ -194,43 +251,13 @@ def _line(frame_areas, frame_index, source, glottal_reflection, rho, c, fs, loss
             for k in range(min(nasal_port, nm - 1)):
                 npatch[k] = 2.0 * np.sqrt(np.pi * 0.5 * (nas[k] + nas[k + 1])) * dx
         new_f[0] = glottal_reflection * bwd[0] + source[s] / area[0]
-        skin_u = 0.0
-        for j in range(n - 1):  # each junction's pressure p / (rho c) = f + b from the flows U = A (f - b) into it
-            a_sum = area[j] + area[j + 1]
-            into = 2.0 * (area[j] * fwd[j] + area[j + 1] * bwd[j + 1])
-            if j == inject_at[s]:  # the air through a constriction as it starts and stops (a release's transient)
-                into += inject[s]
-            main = a_sum
-            if nasal and j == nasal_at:  # the port: the nasal branch's flow joins
-                a_sum += port
-                into += 2.0 * port * nb[0]
-            if j == branch_at:  # three tubes meet: the side branch's flow joins
-                a_sum += branch_areas[0]
-                into += 2.0 * branch_areas[0] * bb[0]
-            elif walls:  # less what the junction's wall patch takes; the wall's velocity and the pressure solved
-                # together (backward Euler): stable for any area, a closure's slit included
-                patch = 2.0 * np.sqrt(pi * 0.5 * main) * dx
-                wall_v[j] = ((wall_m / dt) * wall_v[j] + rho * c * into / a_sum - wall_k * wall_x[j]) / (
-                    wall_m / dt + rho * c * patch / a_sum + wall_r + wall_k * dt)
-                wall_x[j] += dt * wall_v[j]
-                into -= patch * wall_v[j]
-                skin_u += patch * wall_v[j]
-            pj = into / a_sum
-            new_f[j + 1] = pj - bwd[j + 1]
-            new_b[j] = pj - fwd[j]
-            if j == branch_at:
-                new_bf[0] = pj - bb[0]
-            if nasal and j == nasal_at:
-                new_nf[0] = pj - nb[0]
-        k_n = noise_at[s]
-        if 0 <= k_n < n - 1:  # a series pressure source between sections k_n and k_n + 1: half each way
-            half = 0.5 * noise[s] / (rho * c)
-            new_f[k_n + 1] += half
-            new_b[k_n] -= half
+        skin_u = _junctions(area, fwd, bwd, new_f, new_b, wall_x, wall_v, wall, rho, c, dt, dx, branch_at,
+                            branch_areas, bb, new_bf, nasal_at if nasal else -1, port, nb, new_nf, inject[s],
+                            inject_at[s])
+        if 0 <= noise_at[s] < n - 1:  # the jet's turbulence past the narrowest place
+            _pressure_source(new_f, new_b, noise[s], noise_at[s], rho, c)
         if aspiration.shape[0] > 0:  # the glottis's turbulence, just above it
-            half = 0.5 * aspiration[s] / (rho * c)
-            new_f[1] += half
-            new_b[0] -= half
+            _pressure_source(new_f, new_b, aspiration[s], 0, rho, c)
         if m > 0:
             _branch_step(branch_areas, bf, bb, new_bf, new_bb, keep)
         u_nose = 0.0
@@ -241,13 +268,10 @@ def _line(frame_areas, frame_index, source, glottal_reflection, rho, c, fs, loss
         elif was_open:  # the port shut: the nasal tract's air column is cut off, its waves gone
             for arr in (nf, nb, nwv, nwx, sv, sx):
                 arr[:] = 0.0
-            rad[0] = 0.0
-            rad[1] = 0.0
-            was_open = False
+            rad[0], rad[1], was_open = 0.0, 0.0, False
         a_l = area[n - 1]
         new_b[n - 1] = _lips_reflect(a_l, fwd[n - 1], last_f, last_b, rho, c, fs)
-        last_f = fwd[n - 1]
-        last_b = new_b[n - 1]
+        last_f, last_b = fwd[n - 1], new_b[n - 1]
         u = area[n - 1] * (fwd[n - 1] - new_b[n - 1]) if a_l > 2e-4 else 0.0  # closed lips radiate nothing
         if nasal:
             u += u_nose
@@ -257,13 +281,7 @@ def _line(frame_areas, frame_index, source, glottal_reflection, rho, c, fs, loss
             u += skin * skin_u
         out[s] = u - last_u
         last_u = u
-        for j in range(n):
-            if area[j] <= MIN_AREA_CM2:  # a closed section holds no air column: no wave stays trapped in it to
-                fwd[j] = 0.0  # leave as a click when it opens (its flow A (f - b) would jump with its area)
-                bwd[j] = 0.0
-            else:
-                fwd[j] = keep * new_f[j]
-                bwd[j] = keep * new_b[j]
+        _advance(area, fwd, bwd, new_f, new_b, keep)
     return out
 
 

@@ -211,8 +211,9 @@ def synthesize_speech(lengths_cm: np.ndarray, areas_cm2: np.ndarray, times_s: np
     extra = Extra(voice_gain=up(gain), skin=1.0 if so.voice_bar and ac.yielding_walls else 0.0)
     if so.aspiration:
         extra.aspiration = up(asp) * np.random.default_rng(so.seed).standard_normal(len(t))
-    if so.bursts:  # the cavity's discharge (zero while its pressure holds) leaves where the closure was
-        extra.inject = up(air.constriction + air.nasal - air.glottal)
+    if so.bursts:  # the cavity's discharge through the mouth (beyond what the glottis feeds it, less what leaves
+        # by the nose; zero while its pressure holds or rises) leaves where the closure was
+        extra.inject = up(np.maximum(air.constriction - np.maximum(air.glottal - air.nasal, 0.0), 0.0))
         extra.inject_at = np.repeat(outlet(cav.end, cav.area_cm2, BURST_BELOW_CM2), stride)[:len(t)]
     if so.nasal_branch and ac.nasal.enabled and np.any(np.asarray(larynx.port_cm2) > 0):
         junction = int(np.clip(round(larynx.port_at_cm / (mean_length / n)) - 1, 0, n - 2))
