@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 
 from artic_cli.config import load_config
 from artic_cli.geometry.mesh import tongue_mesh
@@ -251,3 +252,20 @@ def set_force(model, sets: dict[str, tuple[float, float, float]]) -> np.ndarray:
         idx = model.node_set(name)
         f[idx] += np.asarray(fn) * 1e5 / len(idx)
     return f
+
+
+@pytest.fixture(scope="session")
+def small_maps(tmp_path_factory, mesh_file):
+    """Rest-jaw maps: three vectors and one net (the default speaker): (their folder, their config)."""
+    from artic_cli.stages.epmap import build_ep_maps
+
+    tmp = tmp_path_factory.mktemp("amaps")
+    d = yaml.safe_load((ROOT / "configs" / "default.yaml").read_text())
+    d["epmap"] = dict(d.get("epmap", {}), jaw_positions={"rest": {}}, typical_jaw="rest", muscles=["GGp", "HG", "SG"],
+                      levels_n=[0.0, 1.0, 2.5, 4.0], pair_levels_n=[1.0, 2.5, 4.0], pairs_tip=[["GGp", "HG"]],
+                      pairs_dorsum=[], groups=[], net_jaw_positions=["rest"])
+    cfg = tmp / "cfg.yaml"
+    cfg.write_text(yaml.safe_dump(d, sort_keys=False))
+    build_ep_maps(mesh_file, cfg, tmp / "maps.h5", jobs=2, cache=tmp / "cache")
+    return tmp, cfg
+

@@ -51,6 +51,8 @@ def solve_target_cmd(
         out_console.print(f"{r.path} is up to date (same maps, target, options and code)", highlight=False)
     elif r.target.acoustic is not None:
         _print_acoustic_solution(r.target, r.doc, r.path)
+    elif r.target.constriction is not None:
+        _print_constriction_solution(r.target, r.doc, r.path)
     else:
         _print_place_solution(r.target, r.doc, r.path)
 
@@ -75,6 +77,28 @@ def _print_place_solution(t, doc: dict, path: Path) -> None:
         err_console.print(f"target '{t.name}' not reached within {t.crucial.tolerance_cm:g} cm after "
                           f"{doc['refined']['simulations']} simulations (best {doc['refined']['crucial_error_cm']:.3f} "
                           f"cm, written to {path}); raise --budget or the tolerance", highlight=False)
+        raise typer.Exit(3)
+
+
+def _print_constriction_solution(t, doc: dict, path: Path) -> None:
+    g = t.constriction
+    ch = doc["chosen"]
+    forces = lambda d: ", ".join(f"{k} {v:g} N" for k, v in d.items()) or "no tongue force"  # noqa: E731
+    out_console.print(f"{t.name}: {ch['family']} {ch['map']}: {forces(ch['forces_n'])}; predicted {g.place} area "
+                      f"{ch['place_area_cm2']:.3f} cm^2 (target {g.area_cm2:g} +- {g.tolerance_cm2:g}; best of "
+                      f"{doc['candidates_considered']} candidates)", highlight=False)
+    for key, label in (("verified", "verified by simulation"), ("refined", "refined")):
+        if key in doc:
+            r = doc[key]
+            out_console.print(f"{label}: {forces(r['forces_n'])}; {g.place} area {r['place_area_cm2']:.3f} cm^2"
+                              + (f" (forces x {r['scale']:g}) after {r['simulations']} simulations"
+                                 if key == "refined" else ""), highlight=False)
+    out_console.print(f"wrote {path}", highlight=False)
+    last = doc.get("refined")
+    if last is not None and not last["converged"]:
+        err_console.print(f"target '{t.name}': the {g.place} area {last['place_area_cm2']:.3f} cm^2 misses "
+                          f"{g.area_cm2:g} +- {g.tolerance_cm2:g} cm^2 after {last['simulations']} simulations "
+                          f"(written to {path}); raise --budget or choose another jaw position", highlight=False)
         raise typer.Exit(3)
 
 

@@ -94,16 +94,33 @@ def acoustic_maps(cfg, mesh, maps, progress: Callable[[int, int], None] | None =
 
 class EPFormants:
     """The formant oracle of acoustic targets: ``(jaw, lip area cm^2, lip length cm, port cm^2) -> FormantNets``
-    (every EP's formants at a jaw position).  The stored acoustic maps answer for the config's lips and port and
+    (every EP's formants at a jaw position), and of constriction targets: ``areas(jaw)``.  The stored acoustic maps answer for the config's lips and port and
     its mapped lip tubes; other lips or ports are computed from the EPs' shapes, one jaw position at a time
     (0.4 s for a jaw position's vectors, 4.5 s with its nets); each answer is kept."""
 
-    def __init__(self, cfg, mesh, load_maps: Callable[[], object], stored: AcousticMaps | None = None):
+    def __init__(self, cfg, mesh, load_maps: Callable[[], object], stored: AcousticMaps | None = None,
+                 read_areas: Callable[[], AcousticMaps] | None = None):
         vt = speaker_tract(cfg)
         self.cfg, self.mesh, self.load_maps, self.stored = cfg, mesh, load_maps, stored
+        self.read_areas = read_areas  # the stored maps with their area functions, read when first asked
         self.defaults = (float(vt.lips.area_cm2), float(vt.lips.length_cm), float(vt.velum_port_cm2))
         self.cache: dict = {}
         self.whole = None  # the maps with the EPs' shapes, read once when other lips or ports need them
+
+    def areas(self, jaw: str) -> dict:
+        """Every EP's area function at a jaw position with the config's lips and port: net key -> (*grid, S)
+        cm^2 (the stored acoustic maps', else computed from the EPs' shapes; kept)."""
+        key = ("areas", jaw)
+        if key not in self.cache:
+            held = self.read_areas() if self.read_areas is not None else None
+            if held is not None and jaw in held.jaws:
+                self.cache[key] = {k: n.area_cm2 for k, n in held.jaws[jaw].items()}
+            else:
+                if self.whole is None:
+                    self.whole = self.load_maps()
+                nets = acoustic_maps(self.cfg, self.mesh, self.whole, jaws=[jaw], bandwidths=False).jaws[jaw]
+                self.cache[key] = {k: n.area_cm2 for k, n in nets.items()}
+        return self.cache[key]
 
     def __call__(self, jaw: str, area: float, length: float, port: float) -> dict:
         key = (jaw, *lip_key(area, length), round(port, 6))

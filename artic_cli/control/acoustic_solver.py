@@ -17,7 +17,7 @@ import numpy as np
 from ..errors import UnreachableTarget
 from ..units import hz_to_bark
 from .epmap import JawMaps
-from .solver import (Candidate, TargetSpec, bilinear, polyline_nearest, settled_run, cell_corners, good_cells,
+from .solver import (Candidate, TargetSpec, bilinear, mapped_nets, polyline_nearest, settled_run, cell_corners, good_cells,
                      indecisive_cost, invert_cells)
 
 FormantNets = dict  # "single/SG" | "pair/A+B" | "group/I+A+B" -> (*grid, K) formants of the net's EPs, Hz
@@ -88,17 +88,7 @@ class AcousticProblem:
         return out
 
     def _nets(self):
-        for name, net in self.jm.pair.items():
-            f = self.formants.get(f"pair/{name}")
-            if f is not None:
-                yield "pair", name, net.muscles, None, net.levels, net.x, net.converged, f
-        for name, net in self.jm.group.items():
-            f = self.formants.get(f"group/{name}")
-            if f is None:
-                continue
-            for k in range(1, len(net.levels[0])):  # level 0 of a group is its pair net
-                yield ("group", name, net.muscles, (net.muscles[0], float(net.levels[0][k])), net.levels[1:],
-                       net.x[k], net.converged[k], f[k])
+        return mapped_nets(self.jm, self.formants)
 
     @staticmethod
     def _cells(x: np.ndarray, conv: np.ndarray, f: np.ndarray):

@@ -76,6 +76,19 @@ class AcousticGoal(Strict):
         return increasing(v, "formants must increase (F1 < F2 < F3)")
 
 
+class Constriction(Strict):
+    """The area a place of the tract must have: a closure (0) or a channel.  ``place`` names a region of the
+    tract's area law (``vocal_tract.area_law``: alveolar, hard palate, velum, ...); the place's area is its
+    narrowest section's.  A closure counts at or below ``tolerance_cm2``; a channel within it of its area."""
+
+    place: str
+    area_cm2: Annotated[float, Field(ge=0, le=5, allow_inf_nan=False)]
+    tolerance_cm2: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = 0.01
+
+    def met(self, area_cm2: float) -> bool:
+        return bool(np.isfinite(area_cm2) and abs(area_cm2 - self.area_cm2) <= self.tolerance_cm2)
+
+
 class Lips(Strict):
     area_cm2: Annotated[float, Field(gt=0, le=10, allow_inf_nan=False)]
     length_cm: Annotated[float, Field(gt=0, le=4, allow_inf_nan=False)]
@@ -92,12 +105,18 @@ class TargetSpec(Strict):
     name: SafeName = "target"  # becomes the solution's file name
     jaw: JawSpec = JawSpec(forces_n={"JO": 0.5})
     crucial: Crucial | None = None  # a place for a control point, or ...
-    acoustic: AcousticGoal | None = None  # ... formants (a vowel): one of the two
+    acoustic: AcousticGoal | None = None  # ... formants (a vowel), or ...
+    constriction: Constriction | None = None  # ... the area at a place of the tract: one of the three
     indecisive: list[Indecisive] = []
     lips: Lips | Literal["neutral", "rounded", "compressed", "spread", "open"] | None = None  # acoustic targets only
     velum_port_cm2: Annotated[float, Field(ge=0, le=5, allow_inf_nan=False)] | None = None
     force_weight: NonNegative = 1.0  # per N^2
     distance_weight: NonNegative = 100.0  # per cm^2
+
+    @property
+    def needs_tract(self) -> bool:
+        """Whether the target is judged on the vocal tract (formants or a place's area), not on a point."""
+        return self.acoustic is not None or self.constriction is not None
 
     def lip_tube(self, default: tuple[float, float]) -> tuple[float, float]:
         """(area cm^2, length cm) of the target's lips; ``default``: the config's."""
@@ -106,15 +125,16 @@ class TargetSpec(Strict):
 
 
 def parse_target(data: object, source: str = "<target>", max_force_n: float = DEFAULT_MAX_FORCE_N) -> TargetSpec:
-    t = parse(TargetSpec, data, source, "target (with 'crucial' or 'acoustic', and 'jaw', 'indecisive')",
+    t = parse(TargetSpec, data, source, "target (with 'crucial', 'acoustic' or 'constriction', and 'jaw', "
+              "'indecisive')",
               "fix the target and rerun",
               context={"max_force_n": max_force_n})
-    if (t.crucial is None) == (t.acoustic is None):
-        raise ArticError(f"{source}: give either 'crucial' (a control point's place) or 'acoustic' (formants), "
-                         "one of them")
+    if sum(x is not None for x in (t.crucial, t.acoustic, t.constriction)) != 1:
+        raise ArticError(f"{source}: give either 'crucial' (a control point's place), 'acoustic' (formants) or "
+                         "'constriction' (a place's area), one of them")
     if t.crucial is None and t.jaw.forces_n is None:
-        raise ArticError(f"{source}: key 'jaw': an acoustic target needs jaw.forces_n of a mapped jaw position "
-                         "(the acoustic maps hold the EPs' shapes only there)")
+        raise ArticError(f"{source}: key 'jaw': an acoustic or constriction target needs jaw.forces_n of a mapped "
+                         "jaw position (the acoustic maps hold the EPs' shapes only there)")
     if t.crucial is not None and (t.lips is not None or t.velum_port_cm2 is not None):
         raise ArticError(f"{source}: keys 'lips' and 'velum_port_cm2' belong to acoustic targets; remove them or "
                          "give 'acoustic' instead of 'crucial'")
@@ -199,6 +219,23 @@ def _cells(net2: np.ndarray, conv: np.ndarray):
     """Cells of a 2-D grid (na, nb, 3, 3) of EPs whose four corners settled: indices and corners (C, 4, 2, 2)."""
     ii, jj = good_cells(conv)
     return ii, jj, cell_corners(net2, ii, jj)[..., :2, :2]  # tip and dorsum, x and y
+
+
+def mapped_nets(jm: JawMaps, values: dict):
+    """The 2-D nets of a jaw position with a value per EP (``values``: "pair/A+B" | "group/I+A+B" -> (*grid,
+    ...)): (family, name, muscles, fixed (independent muscle, level N) or None, the two varied levels, EPs,
+    settled, values), each co-contraction level of a group as its own net (level 0 is its pair net)."""
+    for name, net in jm.pair.items():
+        v = values.get(f"pair/{name}")
+        if v is not None:
+            yield "pair", name, net.muscles, None, net.levels, net.x, net.converged, v
+    for name, net in jm.group.items():
+        v = values.get(f"group/{name}")
+        if v is None:
+            continue
+        for k in range(1, len(net.levels[0])):
+            yield ("group", name, net.muscles, (net.muscles[0], float(net.levels[0][k])), net.levels[1:],
+                   net.x[k], net.converged[k], v[k])
 
 
 def indecisive_cost(target: TargetSpec, forces: dict[str, float], pred: np.ndarray) -> float:

@@ -40,6 +40,8 @@ class Context:
     lips_default: tuple[float, float] = (3.0, 1.0)  # area cm^2, length cm
     port_default: float = 0.0  # cm^2
     acoustic_sha256: str | None = None  # the acoustic maps' content, when they gave the formants
+    areas: Callable[[str], dict] | None = None  # constriction targets: jaw -> net key -> (*grid, S) areas, cm^2
+    places: tuple | None = None  # (S,) each section's place index and the places' names
 
 
 def jaw_maps(ctx: Context, target: TargetSpec) -> tuple[JawMaps, dict[str, float], float, str]:
@@ -214,6 +216,10 @@ def solve(ctx: Context, target: TargetSpec, simulator=None, verify: bool = False
     """Solve one target; returns the result document (plain data, units in the keys)."""
     if target.acoustic is not None:
         return solve_acoustic(ctx, target, simulator, verify, refine, budget)
+    if target.constriction is not None:
+        from .constriction import solve_constriction
+
+        return solve_constriction(ctx, target, simulator, verify, refine, budget)
     jm, jaw_forces, height, how = jaw_maps(ctx, target)
     cands = solve_on(jm, target, REFINE_REACH_CM if refine else None)
     chosen = cands[0]

@@ -98,7 +98,7 @@ def needs_dynamic(targets: list[TargetSpec | None], cfg: Config) -> bool:
     carries the typical map there)."""
     netted = [canonical(cfg.epmap.jaw_positions[n]) for n in cfg.epmap.net_jaw_positions
               if n in cfg.epmap.jaw_positions]
-    return any(t is not None and t.acoustic is None and
+    return any(t is not None and not t.needs_tract and
                (t.jaw.forces_n is None or canonical(dict(t.jaw.forces_n)) not in netted) for t in targets)
 
 
@@ -165,7 +165,7 @@ def plan(u: Utterance, cfg: Config, targets: list[TargetSpec | None], solve: Sol
         f, note, path = done[target_key(t)]
         labels.append(s.label or t.name)
         forces.append(f)
-        lips.append(t.lip_tube(default_lips) if t.acoustic is not None else default_lips)
+        lips.append(t.lip_tube(default_lips) if t.needs_tract else default_lips)
         ports.append(float(vt.velum_port_cm2 if t.velum_port_cm2 is None else t.velum_port_cm2))
         notes.append(note)
         files.append(str(path))

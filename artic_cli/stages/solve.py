@@ -15,6 +15,8 @@ from ..errors import ArticError, UnreachableTarget
 from ..io.fingerprint import digest
 from ..io.store import content_hash_of, read_doc, stored_content_hash, write_doc
 from ..mechanics.model import ARTICULATOR_SECTIONS
+from ..tract.places import section_places
+from ..tract.speaker import speaker_tract
 from . import acoustic_map as am_stage
 from . import dynamic as dynamic_stage
 from . import epmap as epmap_stage
@@ -57,8 +59,16 @@ def add_formants(ctx: Context, maps: Path | str, mesh: Path | str, config: Path 
                              "rerun 'artic acoustic-map' (or leave --acoustic-maps out)")
         stored = am_stage.read(acoustic_maps, formants_only=True)
         ctx.acoustic_sha256 = str(stored_content_hash(acoustic_maps))
-    oracle = EPFormants(cfg, m.mesh, lambda: epmap_stage.read(maps), stored)
+    held = {}
+
+    def read_areas():  # once, when a constriction target first asks
+        if "maps" not in held:
+            held["maps"] = am_stage.read(acoustic_maps) if stored is not None else None
+        return held["maps"]
+
+    oracle = EPFormants(cfg, m.mesh, lambda: epmap_stage.read(maps), stored, read_areas)
     ctx.formants, ctx.lips_default, ctx.port_default = oracle, oracle.defaults[:2], oracle.defaults[2]
+    ctx.areas, ctx.places = oracle.areas, section_places(speaker_tract(cfg))
     return ctx
 
 
@@ -93,10 +103,10 @@ def solve_target(target: Path | str | TargetSpec, ctx: Context, out: Path | str 
     path = Path(out) if out is not None else paths.SOLUTIONS / f"{t.name}.yaml"
     cfg = load_config(config) if (verify or refine) else None
     inputs = {"epmaps": ctx.maps_sha256, "dynamic": ctx.dynamic_sha256, "target": digest(t.model_dump(mode="json"))}
-    if verify or refine or t.acoustic is not None:
+    if verify or refine or t.needs_tract:
         inputs["mesh"] = mesh_sha256
     sections = SPATIAL_SECTIONS
-    if t.acoustic is not None:  # the lips, the tract and its acoustics matter too
+    if t.needs_tract:  # the lips, the tract and its acoustics matter too
         cfg = load_config(config)
         inputs["acoustic_maps"] = ctx.acoustic_sha256
         sections = STAGE.sections

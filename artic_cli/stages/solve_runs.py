@@ -60,17 +60,17 @@ def _solve_here(targets: list[TargetSpec], maps, mesh, acoustic_maps, config, fo
         return []
     ctx = load_context(maps, dynamic, mesh)
     sim = voicer = None
-    if any(t.acoustic is not None for t in targets):
+    if any(t.needs_tract for t in targets):
         add_formants(ctx, maps, mesh, config, acoustic_maps)
         voicer = simulator(mesh, config, voiced=True)
-    if any(t.acoustic is None for t in targets):
+    if any(not t.needs_tract for t in targets):
         sim = voicer.sim if voicer is not None else simulator(mesh, config)
     mesh_sha = (voicer.sim if voicer is not None else sim).mesh_sha256
     out = []
     for t in targets:
         path = solution_path(folder, t)
         try:
-            doc, path, _ = solve_target(t, ctx, path, voicer if t.acoustic is not None else sim, False, True, budget,
+            doc, path, _ = solve_target(t, ctx, path, voicer if t.needs_tract else sim, False, True, budget,
                                         config, mesh_sha)
             out.append(Answer(doc, path))
         except UnreachableTarget as err:
@@ -102,8 +102,8 @@ def solve_files(target: Path | str | None = None, batch: Path | str | None = Non
     check_number("--budget", budget, ge=1)
     check_number("--jobs", jobs, ge=1)
     targets = read_batch(batch) if batch is not None else [load_target(target)]  # the user's file first
-    acoustic = any(t.acoustic is not None for t in targets)
-    spatial = any(t.acoustic is None for t in targets)  # acoustic targets use the mapped jaw positions only
+    acoustic = any(t.needs_tract for t in targets)
+    spatial = any(not t.needs_tract for t in targets)  # acoustic targets use the mapped jaw positions only
     ctx = load_context(maps, dynamic if spatial else None, mesh if (verify or refine or acoustic) else None)
     if acoustic:
         add_formants(ctx, maps, mesh, config, acoustic_maps)

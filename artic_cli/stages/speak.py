@@ -193,7 +193,7 @@ def speak(utterance: Path | str, out: Path | str | None = None, maps: Path | str
         inputs["epmaps"] = stored_content_hash(maps) or ""
         if dynamic is not None and needs_dynamic(targets, cfg):
             inputs["dynamic"] = stored_content_hash(dynamic) or ""
-        if any(t is not None and t.acoustic is not None for t in targets):
+        if any(t is not None and t.needs_tract for t in targets):
             inputs["acoustic_maps"] = (stored_content_hash(acoustic_maps) or "") if acoustic_maps is not None else ""
     prov = STAGE.provenance(cfg, inputs=inputs, params={"accept_nearest": accept_nearest, "budget": budget})
     files = {"wav": out, "textgrid": textgrid_path(out), "h5": h5_path(out)}

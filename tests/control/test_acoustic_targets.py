@@ -10,7 +10,6 @@ from artic_cli.control.acoustic_solver import solve_acoustic_on, within
 from artic_cli.control.epmap import JawMaps, Net
 from artic_cli.control.solver import parse_target
 from artic_cli.errors import ArticError, UnreachableTarget
-from artic_cli.stages.epmap import build_ep_maps
 from artic_cli.stages.solve import add_formants, load_context, simulator, solve_target
 
 from conftest import ROOT, praat_formants_near, need
@@ -63,20 +62,6 @@ def test_formants_inside_a_net_give_the_forces_that_make_them():
     assert within(_acoustic(goal, tol=0.2), best.detail["formants_hz"])
     with pytest.raises(UnreachableTarget, match="nearest mapped formants are F1 .* Hz"):
         solve_acoustic_on(jm, _acoustic((300, 2600), tol=5.0), formants)
-
-
-@pytest.fixture(scope="module")
-def small_maps(tmp_path_factory, mesh_file):
-    """Rest-jaw maps: three vectors and one net (the default speaker)."""
-    tmp = tmp_path_factory.mktemp("amaps")
-    d = yaml.safe_load((ROOT / "configs" / "default.yaml").read_text())
-    d["epmap"] = dict(d.get("epmap", {}), jaw_positions={"rest": {}}, typical_jaw="rest", muscles=["GGp", "HG", "SG"],
-                      levels_n=[0.0, 1.0, 2.5, 4.0], pair_levels_n=[1.0, 2.5, 4.0], pairs_tip=[["GGp", "HG"]],
-                      pairs_dorsum=[], groups=[], net_jaw_positions=["rest"])
-    cfg = tmp / "cfg.yaml"
-    cfg.write_text(yaml.safe_dump(d, sort_keys=False))
-    build_ep_maps(mesh_file, cfg, tmp / "maps.h5", jobs=2, cache=tmp / "cache")
-    return tmp, cfg
 
 
 @pytest.fixture(scope="module")

@@ -160,7 +160,7 @@ def test_batch_solves_rows_and_marks_unreachable_ones(maps, tmp_path):
 
 
 BAD_TARGETS = {
-    "missing crucial": ("name: x\n", "give either 'crucial' (a control point's place) or 'acoustic'"),
+    "missing crucial": ("name: x\n", "give either 'crucial' (a control point's place), 'acoustic'"),
     "wrong type": ("crucial: {point: tip, at_cm: [a, 1]}\n", "crucial.at_cm"),
     "no such point": ("crucial: {point: nose, at_cm: [0, 0]}\n", "'nose' is not one of the valid values ('tip' or 'dorsum')"),
     "unknown key": ("crucial: {point: tip, at_cm: [0, 0], tol: 1}\n", "unknown key 'crucial.tol'"),
