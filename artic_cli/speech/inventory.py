@@ -1,0 +1,111 @@
+"""The phoneme inventory (``configs/phonemes/japanese.yaml``): each phoneme's articulatory features, validated
+on load (docs/inventory.md), and romaji split into its symbols."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Literal
+
+from pydantic import Field, model_validator
+
+from ..config import read_yaml
+from ..control.solver import JawSpec
+from ..errors import ArticError
+from ..validation import DurationMs, FormantHz, Strict, increasing, parse
+
+ROOT = Path(__file__).resolve().parents[2]
+DEFAULT = ROOT / "configs" / "phonemes" / "japanese.yaml"
+SYMBOLS = ("a i u e o k g s z t d n h b p m y r w f sh ch ts j ky gy ny hy my ry py by N Q").split()
+
+Manner = Literal["vowel", "stop", "nasal", "fricative", "affricate", "tap", "approximant", "moraic_nasal", "geminate"]
+Place = Literal["bilabial", "alveolar", "postalveolar", "palatal", "velar", "glottal"]
+Height = Literal["high-front", "high-central", "high-back", "mid-front", "mid-central", "mid-back", "low-front",
+                 "low-central", "low-back"]
+Area = Annotated[float, Field(gt=0, le=2, allow_inf_nan=False)]
+NEEDS_PLACE = ("stop", "nasal", "fricative", "affricate", "tap", "approximant")
+
+
+class Phoneme(Strict):
+    manner: Manner
+    place: Place | None = None
+    voiced: bool = True
+    channel_cm2: Area | None = None  # a fricative's or affricate's channel, a glide's narrowing
+    velum_port_cm2: Annotated[float, Field(ge=0, le=2, allow_inf_nan=False)] = 0.0
+    glottis_cm2: Area | None = None  # else adducted (voiced) or speech.glottal_area_voiceless_cm2
+    lips: Literal["closed", "rounded", "compressed", "spread", "neutral", "open"] = "neutral"
+    jaw: JawSpec | None = None
+    formants_hz: Annotated[list[FormantHz], Field(min_length=2, max_length=3)] | None = None
+    tongue_highest: Height | None = None
+    palatalized: bool = False
+    duration_ms: DurationMs
+
+    @model_validator(mode="after")
+    def _features(self):
+        m = self.manner
+        if m == "vowel":
+            if self.formants_hz is None or self.tongue_highest is None:
+                raise ValueError("a vowel needs formants_hz and tongue_highest")
+            increasing(self.formants_hz, "formants must increase (F1 < F2 < F3)")
+        elif self.formants_hz is not None or self.tongue_highest is not None:
+            raise ValueError("formants_hz and tongue_highest belong to vowels")
+        if m in NEEDS_PLACE and self.place is None:
+            raise ValueError(f"a {m} needs a place")
+        if m in ("fricative", "affricate", "approximant") and self.channel_cm2 is None and self.place != "glottal":
+            raise ValueError(f"a {m} needs channel_cm2 (its narrowing at the place)")
+        if m in ("nasal", "moraic_nasal") and self.velum_port_cm2 <= 0:
+            raise ValueError("a nasal needs velum_port_cm2 > 0 (the port open)")
+        if m not in ("nasal", "moraic_nasal") and self.velum_port_cm2 > 0:
+            raise ValueError("only nasals open the port (velum_port_cm2)")
+        return self
+
+
+class Inventory(Strict):
+    schema_version: Literal[1]
+    language: str
+    sources: list[str] = []
+    places: dict[Place, str]  # a phonetic place -> the tract's place (an area-law region, lips or glottis)
+    phonemes: dict[str, Phoneme]
+
+    @model_validator(mode="after")
+    def _complete(self):
+        missing = [s for s in SYMBOLS if s not in self.phonemes]
+        if missing:
+            raise ValueError(f"phonemes: missing {', '.join(missing)} (the inventory names {len(SYMBOLS)} symbols)")
+        for sym, p in self.phonemes.items():
+            if p.place is not None and p.place not in self.places:
+                raise ValueError(f"phonemes.{sym}.place: '{p.place}' has no entry under 'places'")
+        return self
+
+    def check_places(self, tract_places: tuple[str, ...], source: str = "inventory") -> None:
+        """Every place maps to one the tract has (its area law's regions, lips) or the glottis."""
+        for place, where in self.places.items():
+            if where != "glottis" and where not in tract_places:
+                raise ArticError(f"{source}: places.{place}: '{where}' is not a place of the tract; places: "
+                                 f"{', '.join(tract_places)}, glottis")
+
+    def phones(self, text: str) -> list[str]:
+        """Romaji split into the inventory's symbols, longest first (``sh`` before ``s``); ``N`` and ``Q`` as
+        written; spaces between words ignored.  An unknown character is an error naming it and its place."""
+        out, k = [], 0
+        longest = max(len(s) for s in self.phonemes)
+        while k < len(text):
+            if text[k].isspace():
+                k += 1
+                continue
+            for n in range(min(longest, len(text) - k), 0, -1):
+                if text[k:k + n] in self.phonemes:
+                    out.append(text[k:k + n])
+                    k += n
+                    break
+            else:
+                raise ArticError(f"--text: '{text[k]}' at position {k + 1} is not in the inventory; symbols: "
+                                 f"{' '.join(self.phonemes)}")
+        return out
+
+
+def load_inventory(path: Path | str = DEFAULT) -> Inventory:
+    return parse(Inventory, read_yaml(path, "phoneme inventory"), str(path),
+                 "phoneme inventory (schema_version, places, phonemes)", "fix the inventory and rerun")
+
+
+__all__ = ["Inventory", "Phoneme", "SYMBOLS", "load_inventory"]
