@@ -61,7 +61,7 @@ def speech_synthesis(cfg, lengths, areas, times) -> None:
     bar, and the nasal branch with the port shut and open the whole second.  Goal: at most 0.1 s per second
     of audio on one core."""
     from artic_cli import units
-    from artic_cli.acoustics.voice import Larynx, synthesize_speech
+    from artic_cli.acoustics.sources import Larynx, synthesize_speech
 
     def larynx(port_cm2: float, frames: int = len(times)) -> Larynx:
         return Larynx(glottis_cm2=np.full(frames, 0.05), port_cm2=np.full(frames, port_cm2),

@@ -19,7 +19,8 @@ from .. import units
 from ..acoustics.aerodynamics import Turbulence
 from ..acoustics.analysis import analyse
 from ..acoustics.tube import Tube
-from ..acoustics.voice import Audio, Larynx, synthesize_speech
+from ..acoustics.sources import Larynx, synthesize_speech
+from ..acoustics.voice import Audio
 from ..config import Config
 from ..errors import ArticError, NotPhysical
 from ..geometry.anatomy import TONGUE_MUSCLES

@@ -6,7 +6,6 @@ it was with the port closed and the new sources off; bad inputs."""
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest

@@ -43,7 +43,7 @@ A = {"forces_n": {"JO": 2.5, "HG": 1.0}, "duration_ms": 150, "label": "a"}  # th
     ({"segments": [dict(A, forces_n={"XYZ": 1.0})]}, "'XYZ' is unknown"),
     ({"segments": [dict(A, forces_n={"GGp": -1.0})]}, "forces_n.GGp"),
     ({"segments": [dict(A, press=1.5)]}, "'press' scales a solved target's forces"),
-    ({"segments": [A], "lead_ms": 0, "prepare_ms": 0, "segments": [A, dict(A, lead_ms=200)]}, "shorten its lead_ms"),
+    ({"lead_ms": 0, "prepare_ms": 0, "segments": [A, dict(A, lead_ms=200)]}, "shorten its lead_ms"),
     ({"segments": [dict(A, lead_ms=-10)]}, "segments.0.lead_ms"),
     ({"segments": [{"target": {"name": "x", "crucial": {"point": "tip", "at_cm": [0, 0]}, "acoustic":
                                 {"formants_hz": [500, 1500]}}, "duration_ms": 100}]}, "one of them"),
