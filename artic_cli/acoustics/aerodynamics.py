@@ -48,20 +48,6 @@ def noise_rms(u: np.ndarray, area_cm2: np.ndarray, rho: float, mu: float, critic
     return gain * drop * onset
 
 
-def turbulence(length_cm: np.ndarray, area_cm2: np.ndarray, glottis_cm2: np.ndarray, lung_pressure: float,
-               rho: float, mu: float, critical: float, gain: float) -> Turbulence:
-    """Per frame (F, S sections, glottis first): the narrowest section, the flow, and the noise source at the
-    constriction's downstream end."""
-    L, A = np.asarray(length_cm, float), np.asarray(area_cm2, float)
-    k = np.argmin(A, axis=1)
-    rows = np.arange(len(A))
-    ac = A[rows, k]
-    ends = np.cumsum(L, axis=1)[rows, k]
-    u = flow(np.full(len(A), lung_pressure), glottis_cm2, ac, rho)
-    return Turbulence(flow_cm3_s=u, reynolds=reynolds(u, ac, rho, mu),
-                      noise_rms_dyn_cm2=noise_rms(u, ac, rho, mu, critical, gain), at_cm=ends, constriction_cm2=ac)
-
-
 def glottal_noise_rms(u: np.ndarray, glottis_cm2: np.ndarray, rho: float, mu: float, critical: float,
                       coefficient: float) -> np.ndarray:
     """Aspiration: the RMS pressure (dyn/cm^2) of the turbulence the glottal jet makes, Flanagan &

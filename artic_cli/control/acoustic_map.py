@@ -102,7 +102,8 @@ class EPFormants:
                  read_areas: Callable[[], AcousticMaps] | None = None):
         vt = speaker_tract(cfg)
         self.cfg, self.mesh, self.load_maps, self.stored = cfg, mesh, load_maps, stored
-        self.read_areas = read_areas  # the stored maps with their area functions, read when first asked
+        self.read_areas = read_areas  # the stored maps with their area functions, read when first asked ...
+        self.stored_areas: AcousticMaps | None = None  # ... and kept
         self.defaults = (float(vt.lips.area_cm2), float(vt.lips.length_cm), float(vt.velum_port_cm2))
         self.cache: dict = {}
         self.whole = None  # the maps with the EPs' shapes, read once when other lips or ports need them
@@ -112,7 +113,9 @@ class EPFormants:
         cm^2 (the stored acoustic maps', else computed from the EPs' shapes; kept)."""
         key = ("areas", jaw)
         if key not in self.cache:
-            held = self.read_areas() if self.read_areas is not None else None
+            if self.read_areas is not None and self.stored_areas is None:
+                self.stored_areas = self.read_areas()
+            held = self.stored_areas
             if held is not None and jaw in held.jaws:
                 self.cache[key] = {k: n.area_cm2 for k, n in held.jaws[jaw].items()}
             else:

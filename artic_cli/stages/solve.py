@@ -59,13 +59,7 @@ def add_formants(ctx: Context, maps: Path | str, mesh: Path | str, config: Path 
                              "rerun 'artic acoustic-map' (or leave --acoustic-maps out)")
         stored = am_stage.read(acoustic_maps, formants_only=True)
         ctx.acoustic_sha256 = str(stored_content_hash(acoustic_maps))
-    held = {}
-
-    def read_areas():  # once, when a constriction target first asks
-        if "maps" not in held:
-            held["maps"] = am_stage.read(acoustic_maps) if stored is not None else None
-        return held["maps"]
-
+    read_areas = (lambda: am_stage.read(acoustic_maps)) if stored is not None else None  # constriction targets
     oracle = EPFormants(cfg, m.mesh, lambda: epmap_stage.read(maps), stored, read_areas)
     ctx.formants, ctx.lips_default, ctx.port_default = oracle, oracle.defaults[:2], oracle.defaults[2]
     ctx.areas, ctx.places = oracle.areas, section_places(speaker_tract(cfg))

@@ -230,6 +230,21 @@ def test_with_the_port_closed_the_line_is_bit_for_bit_what_it_was():
     assert np.isfinite(opened).all() and not np.array_equal(opened, before)
 
 
+def test_the_compiled_cavities_are_the_plain_ones_on_the_interpolated_areas():
+    from artic_cli.acoustics.airflow import cavities, line_cavities
+
+    rng = np.random.default_rng(1)
+    frames = rng.uniform(0, 4, (5, 43))
+    frames[2, 30:33] = 0.0  # a closure in the middle frame
+    index = np.linspace(0, 4, 333)
+    got = line_cavities(frames, 0.4, index)
+    k0 = np.clip(index.astype(int), 0, 3)
+    w = (index - k0)[:, None]
+    want = cavities(np.full((len(index), 43), 0.4), (1 - w) * frames[k0] + w * frames[k0 + 1])
+    for name in ("index", "end", "area_cm2", "volume_cm3", "wall_cm2"):
+        np.testing.assert_allclose(getattr(got, name), getattr(want, name), rtol=1e-12, atol=1e-12)
+
+
 # --- bad input -----------------------------------------------------------------------------------------------
 
 @pytest.mark.parametrize("change, says", [
