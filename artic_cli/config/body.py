@@ -220,6 +220,9 @@ class SolverSpec(Strict):
 
     verify_ms: Annotated[float, Field(gt=0, le=5000, allow_inf_nan=False)] = 400.0
     verify_hold_jaw: bool = False
+    # a constriction's refinement scales its candidate's tongue forces up to this (N; at least the maps' top
+    # level): a stop presses beyond the EPs the maps hold, the jaw held there, to seal with the jaw free
+    press_max_force_n: Annotated[float, Field(gt=0, le=50, allow_inf_nan=False)] = 8.0
 
 
 class EPMapSpec(Strict):

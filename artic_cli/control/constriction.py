@@ -53,7 +53,27 @@ def nearest_candidates(jm, target: TargetSpec, areas: dict, count: int = WIDEN) 
         k = 1 + int(np.nanargmin(err))
         out.append(p.candidate("single", m, {m: float(net.levels[0][k])}, net.x[k, :2, :2], float(a[k]),
                                 {"segment": k, "fraction": 0.0}))
+    out += _nearest_on_nets(p, g.area_cm2)
     return sorted(out, key=lambda c: (round(c.crucial_error, 3), c.cost))[:count]
+
+
+def _nearest_on_nets(p: ConstrictionProblem, goal: float) -> list[Candidate]:
+    """On each two-muscle net and co-contraction level: the settled EP (not the one of no force) whose place
+    area comes nearest the goal."""
+    out = []
+    for family, name, muscles, fixed, levels, x, conv, a in p.nets_of_areas():
+        err = np.where(conv & np.isfinite(a), np.abs(a - goal), np.inf)
+        err[0, 0] = np.inf
+        if not np.isfinite(err).any():
+            continue
+        i, j = np.unravel_index(int(np.argmin(err)), err.shape)
+        forces = {muscles[-2]: float(levels[0][i])}
+        forces[muscles[-1]] = forces.get(muscles[-1], 0.0) + float(levels[1][j])
+        if fixed is not None:
+            forces[fixed[0]] = forces.get(fixed[0], 0.0) + fixed[1]
+        label = name if fixed is None else f"{name} ({fixed[0]} {fixed[1]:g} N)"
+        out.append(p.candidate(family, label, forces, x[i, j, :2, :2], float(a[i, j]), {"node": [int(i), int(j)]}))
+    return out
 
 
 def solve_constriction(ctx, target: TargetSpec, voicer=None, verify: bool = False, refine: bool = False,

@@ -61,14 +61,14 @@ class ConstrictionProblem:
                 break
         return out
 
-    def _nets(self):
+    def nets_of_areas(self):
         return mapped_nets(self.jm, self.areas)
 
     def nets(self) -> list[Candidate]:
         out = []
         s = np.linspace(0.0, 1.0, SAMPLES)
         uu, vv = (g.ravel() for g in np.meshgrid(s, s, indexing="ij"))
-        for family, name, muscles, fixed, levels, x, conv, a in self._nets():
+        for family, name, muscles, fixed, levels, x, conv, a in self.nets_of_areas():
             ii, jj = good_cells(conv & np.isfinite(a))
             if not len(ii):
                 continue

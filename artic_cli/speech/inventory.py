@@ -9,7 +9,7 @@ from typing import Annotated, Literal
 from pydantic import Field, model_validator
 
 from ..config import read_yaml
-from ..control.solver import JawSpec
+from ..control.solver import JawSpec, Lips
 from ..errors import ArticError
 from ..validation import DurationMs, FormantHz, Strict, increasing, parse
 
@@ -32,7 +32,7 @@ class Phoneme(Strict):
     channel_cm2: Area | None = None  # a fricative's or affricate's channel, a glide's narrowing
     velum_port_cm2: Annotated[float, Field(ge=0, le=2, allow_inf_nan=False)] = 0.0
     glottis_cm2: Area | None = None  # else adducted (voiced) or speech.glottal_area_voiceless_cm2
-    lips: Literal["closed", "rounded", "compressed", "spread", "neutral", "open"] = "neutral"
+    lips: Literal["closed", "rounded", "compressed", "spread", "neutral", "open"] | Lips = "neutral"
     jaw: JawSpec | None = None
     formants_hz: Annotated[list[FormantHz], Field(min_length=2, max_length=3)] | None = None
     tongue_highest: Height | None = None
@@ -59,11 +59,31 @@ class Phoneme(Strict):
         return self
 
 
+Share = Annotated[float, Field(gt=0, lt=1, allow_inf_nan=False)]
+Ms = Annotated[float, Field(ge=0, le=200, allow_inf_nan=False)]
+
+
+class Realisation(Strict):
+    """How entries become targets and tract controls (:mod:`artic_cli.speech.phones`)."""
+
+    vowel_tolerance_pct: Annotated[list[Annotated[float, Field(gt=0, le=50)]], Field(min_length=2, max_length=2)] \
+        = [10.0, 7.0]  # F1's and F2's
+    closure_tolerance_cm2: Annotated[float, Field(gt=0, le=0.1, allow_inf_nan=False)] = 0.01
+    channel_tolerance: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = 0.3  # a share of the channel
+    affricate_closure_share: Share = 0.5  # of an affricate's duration, the rest its channel
+    palatal_glide_share: Share = 0.4  # of a palatalized consonant's duration: the glide to the palate after it
+    nasal_margin_ms: Ms = 30.0  # the port opens this long before a nasal and closes as long after it
+    lip_closing_ms: Ms = 20.0  # a bilabial's lips close over this, shut at its start
+    lip_opening_ms: Ms = 15.0  # ... and open over this from its end
+
+
 class Inventory(Strict):
     schema_version: Literal[1]
     language: str
     sources: list[str] = []
     places: dict[Place, str]  # a phonetic place -> the tract's place (an area-law region, lips or glottis)
+    jaws: dict[Place, JawSpec] = {}  # a consonant's jaw position at its place, unless its entry gives one
+    realisation: Realisation = Realisation()
     phonemes: dict[str, Phoneme]
 
     @model_validator(mode="after")
@@ -74,6 +94,9 @@ class Inventory(Strict):
         for sym, p in self.phonemes.items():
             if p.place is not None and p.place not in self.places:
                 raise ValueError(f"phonemes.{sym}.place: '{p.place}' has no entry under 'places'")
+            if p.place not in (None, "bilabial", "glottal") and p.jaw is None and p.place not in self.jaws:
+                raise ValueError(f"phonemes.{sym}: place '{p.place}' has no jaw; give the entry 'jaw' or add "
+                                 f"jaws.{p.place}")
         return self
 
     def check_places(self, tract_places: tuple[str, ...], source: str = "inventory") -> None:
@@ -108,4 +131,4 @@ def load_inventory(path: Path | str = DEFAULT) -> Inventory:
                  "phoneme inventory (schema_version, places, phonemes)", "fix the inventory and rerun")
 
 
-__all__ = ["Inventory", "Phoneme", "SYMBOLS", "load_inventory"]
+__all__ = ["Inventory", "Phoneme", "Realisation", "SYMBOLS", "load_inventory"]

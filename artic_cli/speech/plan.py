@@ -7,7 +7,7 @@ targets and answers, not the files and processes a solver runs on.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
 
@@ -37,6 +37,7 @@ class Plan:
     glottis_cm2: np.ndarray  # each segment's glottal opening: its own, else adducted (voiced) or abducted
     notes: list[str]  # per segment: how its forces were found
     solutions: list[str]  # the solution files ('' for given forces)
+    continues: list[bool] = field(default_factory=list)  # the same phone as the segment before (one interval)
 
 
 @dataclass
@@ -142,6 +143,17 @@ def settle_answers(items: list[tuple[int, TargetSpec]], solve: Solve, accept_nea
     return out
 
 
+def held(forces: list[dict[str, float]], hold: list[bool]) -> None:
+    """Each held segment takes the forces of the segment before it (the first ones, of the first that is not
+    held), in place."""
+    own = [k for k, h in enumerate(hold) if not h]
+    if not own:
+        raise ArticError("every segment holds the one before; give at least one a target, phoneme or forces")
+    for k, h in enumerate(hold):
+        if h:
+            forces[k] = dict(forces[k - 1] if k > 0 else forces[own[0]])
+
+
 def plan(u: Utterance, cfg: Config, targets: list[TargetSpec | None], solve: Solve, accept_nearest: bool = False,
          say: Callable[[str], None] | None = None) -> Plan:
     """Solve every distinct target once and collect the forces, lips, port and voicing of each segment."""
@@ -155,11 +167,11 @@ def plan(u: Utterance, cfg: Config, targets: list[TargetSpec | None], solve: Sol
     labels, forces, lips, ports, notes, files = [], [], [], [], [], []
     for s, t in zip(u.segments, targets):
         if t is None:
-            labels.append(s.label or "forces")
-            forces.append(dict(s.forces_n))
+            labels.append(s.label or ("held" if s.hold else "forces"))
+            forces.append({} if s.hold else dict(s.forces_n))
             lips.append(default_lips)
             ports.append(float(vt.velum_port_cm2))
-            notes.append("forces given")
+            notes.append("held: the forces of the segment before" if s.hold else "forces given")
             files.append("")
             continue
         f, note, path = done[target_key(t)]
@@ -169,10 +181,11 @@ def plan(u: Utterance, cfg: Config, targets: list[TargetSpec | None], solve: Sol
         ports.append(float(vt.velum_port_cm2 if t.velum_port_cm2 is None else t.velum_port_cm2))
         notes.append(note)
         files.append(str(path))
+    held(forces, [s.hold for s in u.segments])
     starts = np.array(u.starts_ms()) / 1e3
     open_ = cfg.speech.glottal_area_voiceless_cm2
     glottis = np.array([s.glottis_cm2 if s.glottis_cm2 is not None else (vt.glottis_cm2 if s.voiced else open_)
                         for s in u.segments], dtype=float)
     return Plan(labels=labels, starts_s=starts, durations_s=np.array([s.duration_ms for s in u.segments]) / 1e3,
                 forces_n=forces, lips=lips, ports=ports, voiced=np.array([s.voiced for s in u.segments]),
-                glottis_cm2=glottis, notes=notes, solutions=files)
+                glottis_cm2=glottis, notes=notes, solutions=files, continues=[s.continues for s in u.segments])

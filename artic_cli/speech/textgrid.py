@@ -1,4 +1,4 @@
-"""An utterance's segments as a Praat TextGrid."""
+"""An utterance's phones as a Praat TextGrid."""
 
 from __future__ import annotations
 
@@ -6,14 +6,28 @@ from pathlib import Path
 
 from ..io.store import atomic_path
 
+TIER = "phones"
+
+
+def intervals(p) -> list[tuple[float, float, str]]:
+    """(start s, end s, label) of each phone: a plan's segments, those that continue the one before joined."""
+    edges = [round(float(v), 9) for v in (*p.starts_s, p.starts_s[-1] + p.durations_s[-1])]
+    goes_on = list(p.continues) or [False] * len(p.labels)
+    out: list[list] = []
+    for a, b, lab, cont in zip(edges[:-1], edges[1:], p.labels, goes_on):
+        if cont and out:
+            out[-1][1] = b
+        else:
+            out.append([a, b, lab])
+    return [tuple(i) for i in out]
+
 
 def write_textgrid(path: Path | str, p) -> Path:
-    """One interval tier 'segments' from a plan's labels, starts and durations (Praat reads it directly)."""
+    """One interval tier 'phones' from a plan's labels, starts and durations (Praat reads it directly)."""
     from praatio import textgrid
 
-    edges = [round(float(v), 9) for v in (*p.starts_s, p.starts_s[-1] + p.durations_s[-1])]
-    tier = textgrid.IntervalTier("segments", [(a, b, lab) for a, b, lab in zip(edges[:-1], edges[1:], p.labels)],
-                                 0.0, edges[-1])
+    iv = intervals(p)
+    tier = textgrid.IntervalTier(TIER, iv, 0.0, iv[-1][1])
     tg = textgrid.Textgrid()
     tg.addTier(tier)
     with atomic_path(path, ".TextGrid") as tmp:

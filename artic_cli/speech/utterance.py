@@ -13,6 +13,7 @@ Example::
       - {target: configs/targets/consonants/k.yaml, duration_ms: 80, voiced: false, lead_ms: 140, press: 1.5}
       - target: {name: a_open, jaw: {forces_n: {JO: 2.5}}, acoustic: {formants_hz: [753, 1385]}}   # inline
         duration_ms: 250
+      - {phoneme: g, duration_ms: 70}     # a phoneme of the inventory (configs/phonemes/japanese.yaml)
       - {forces_n: {JO: 1.0, GGp: 2.0}, duration_ms: 100, label: push}     # forces given, nothing solved
     tract:                               # optional lip, velum and glottis course on top of the targets'
       - {at_ms: 250, ramp_ms: 40, lip_area_cm2: 0.0}
@@ -43,6 +44,9 @@ MAX_UTTERANCE_MS = 20000.0
 class Segment(Strict):
     target: str | dict | None = None  # a target file, or a target inline
     forces_n: dict[str, ForceN] | None = None  # ... or the forces themselves (muscles, jaw units, groups)
+    phoneme: str | None = None  # ... or a phoneme of the inventory (its target and controls made from it)
+    hold: bool = False  # ... or the forces of the segment before (a bilabial's tongue is its neighbours')
+    continues: bool = False  # the same phone as the segment before (an affricate's release): one interval
     duration_ms: DurationMs
     voiced: bool = True  # the glottis adducted (vocal_tract.glottis_cm2) or abducted (speech.glottal_area_voiceless_cm2)
     glottis_cm2: Annotated[float, Field(ge=0, le=2, allow_inf_nan=False)] | None = None  # ... or this opening
@@ -52,8 +56,11 @@ class Segment(Strict):
 
     @model_validator(mode="after")
     def _one_source(self):
-        if (self.target is None) == (self.forces_n is None):
-            raise ValueError("give either 'target' (a target file or one inline) or 'forces_n', one of them")
+        given = [k for k in ("target", "forces_n", "phoneme") if getattr(self, k) is not None] + (
+            ["hold"] if self.hold else [])
+        if len(given) != 1:
+            raise ValueError("give either 'target' (a target file or one inline), 'phoneme' (a symbol of the "
+                             "inventory) or 'forces_n', one of them")
         if self.forces_n is not None and self.press != 1.0:
             raise ValueError("'press' scales a solved target's forces; with 'forces_n' give the pressed forces")
         return self

@@ -27,7 +27,12 @@ from ..speech.plan import Plan, needs_dynamic, plan, segment_targets
 from ..speech.record import Record
 from ..speech.speak import Spoken, speak_plan
 from ..speech.textgrid import write_textgrid
+from ..speech.inventory import DEFAULT as DEFAULT_INVENTORY
+from ..speech.inventory import load_inventory
+from ..speech.phones import realise
 from ..speech.utterance import Utterance, check_forces, load_utterance
+from ..tract.places import section_places
+from ..tract.speaker import speaker_tract
 from . import mesh as mesh_stage
 from . import paths
 from . import simulate as sim_stage
@@ -171,21 +176,36 @@ def _check_out(out: Path | str) -> Path:
     return out
 
 
-def speak(utterance: Path | str, out: Path | str | None = None, maps: Path | str = paths.EPMAPS,
+def with_phonemes(u: Utterance, cfg: Config, inventory: Path | str | None = None) -> Utterance:
+    """The utterance with its phoneme segments made targets and controls (the inventory read only if it has
+    any; its places checked against the config's tract)."""
+    if not any(s.phoneme is not None for s in u.segments):
+        return u
+    inv = load_inventory(inventory or DEFAULT_INVENTORY)
+    vt = speaker_tract(cfg)
+    inv.check_places(section_places(vt)[1], str(inventory or DEFAULT_INVENTORY))
+    return realise(u, inv, (float(vt.lips.area_cm2), float(vt.lips.length_cm)))
+
+
+def speak(utterance: Path | str | Utterance, out: Path | str | None = None, maps: Path | str = paths.EPMAPS,
           mesh: Path | str = paths.MESH, acoustic_maps: Path | str | None = paths.ACOUSTIC_MAPS,
           config: Path | str | None = None, solutions: Path | str | None = None, accept_nearest: bool = False,
           budget: int = 8, progress=None, say: Callable[[str], None] | None = None, jobs: int = 1,
-          dynamic: Path | str | None = paths.DYNAMIC) -> SpeakResult:
-    """Speak an utterance file: WAV, TextGrid and HDF5 (``out``: the WAV; default data/utterances/NAME.wav).
-    A record that already holds this recipe (the utterance, its targets' solutions, mesh, config, code) is
-    left alone.  ``dynamic``: the dynamic map, for targets at jaw positions the maps hold no nets for (read
-    only for such a target)."""
-    u = load_utterance(utterance)
+          dynamic: Path | str | None = paths.DYNAMIC, inventory: Path | str | None = None) -> SpeakResult:
+    """Speak an utterance (a file, or one made in Python, e.g. from text by
+    :func:`artic_cli.speech.text.utterance_of_text`): WAV, TextGrid and HDF5 (``out``: the WAV; default
+    data/utterances/NAME.wav).  Phoneme segments are made from ``inventory`` (default
+    configs/phonemes/japanese.yaml).  A record that already holds this recipe (the utterance, its targets'
+    solutions, mesh, config, code) is left alone.  ``dynamic``: the dynamic map, for targets at jaw positions
+    the maps hold no nets for (read only for such a target)."""
+    source = None if isinstance(utterance, Utterance) else utterance
+    u = utterance if source is None else load_utterance(source)
     cfg = load_config(config)
+    u = with_phonemes(u, cfg, inventory)
     out = _check_out(out if out is not None else paths.UTTERANCES / f"{u.name}.wav")
     m = mesh_stage.read(mesh, cfg)
     folder = Path(solutions) if solutions is not None else out.parent / "solutions"
-    targets = segment_targets(u, utterance, cfg.muscles.max_force_n)
+    targets = segment_targets(u, source, cfg.muscles.max_force_n)
     # the recipe: what the targets are solved on and with, so an unchanged utterance is known without solving
     inputs = {"mesh": m.content_sha256, "utterance": digest(u.model_dump(mode="json")),
               "targets": [None if t is None else digest(t.model_dump(mode="json")) for t in targets]}
@@ -200,7 +220,7 @@ def speak(utterance: Path | str, out: Path | str | None = None, maps: Path | str
     if up_to_date(files["h5"], prov) and files["wav"].is_file() and files["textgrid"].is_file():
         return SpeakResult(files, None, up_to_date=True)
     model = sim_stage.build(cfg, m.mesh, m.wall)
-    check_forces(u, list(model.drivable()), str(utterance))
+    check_forces(u, list(model.drivable()), str(source or u.name))
     solve = partial(solve_runs.solve_batch, maps=maps, mesh=mesh, acoustic_maps=acoustic_maps, config=config,
                     folder=folder, budget=budget, jobs=jobs,
                     dynamic=dynamic if dynamic is not None and needs_dynamic(targets, cfg) else None)

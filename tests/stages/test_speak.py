@@ -114,7 +114,7 @@ def test_a_spoken_sequence_writes_its_sound_textgrid_and_record(spoken, mesh_fil
     from praatio import textgrid
 
     tg = textgrid.openTextgrid(str(spoken / "lab.TextGrid"), includeEmptyIntervals=False)
-    tier = tg.getTier("segments")
+    tier = tg.getTier("phones")
     assert [e.label for e in tier.entries] == rec.labels
     assert [round(e.start, 6) for e in tier.entries] == pytest.approx(rec.starts_s.tolist())
     # a second run finds everything up to date

@@ -1,0 +1,173 @@
+"""Phonemes made articulation: each ``{phoneme: X}`` segment of an utterance becomes the segments and tract
+controls its inventory entry asks for (docs/inventory.md, "From a phoneme to a target").
+
+* A vowel is a formant target at its jaw position with its lips.
+* A consonant made by the tongue is a constriction target at its place (closure: 0 cm^2; a channel: its
+  ``channel_cm2``) at its place's jaw position (the inventory's ``jaws``), its lips those of the vowel that
+  follows (lip shape anticipates the vowel) unless it names its own.
+* A bilabial or glottal consonant leaves the tongue to its neighbours (``hold``: the previous segment's
+  forces); the lips close (a tract entry) or the glottis opens.
+* An affricate is a closure then a channel, a palatalized consonant its consonant then the palatal glide, a
+  geminate the next consonant held a mora longer, the moraic nasal a closure at the next consonant's place:
+  each part a segment of its own, the later parts ``continues`` (one TextGrid interval per phoneme).
+* A nasal opens the velum port ``nasal_margin_ms`` before it and closes it as long after it; a voiceless
+  phoneme abducts the glottis (its ``glottis_cm2`` or the config's voiceless opening).
+"""
+
+from __future__ import annotations
+
+from ..control.solver import LIP_SHAPES
+from ..errors import ArticError
+from ..schedule import TractEntry
+from .inventory import Inventory, Phoneme
+from .utterance import Segment, Utterance
+
+TONGUELESS = ("bilabial", "glottal")  # places the tongue does not make
+
+
+def _lips(p: Phoneme):
+    """The inventory's lips as a target's ``lips`` (a name, a tube, or None for neutral / closed)."""
+    return None if p.lips in ("neutral", "closed") else p.lips
+
+
+def vowel_target(sym: str, p: Phoneme, inv: Inventory) -> dict:
+    return {"name": f"{sym}_vowel", "jaw": p.jaw.model_dump(exclude_none=True),
+            "acoustic": {"formants_hz": list(p.formants_hz), "tolerance_pct": list(inv.realisation.vowel_tolerance_pct)},
+            **({"lips": _dump(_lips(p))} if _lips(p) is not None else {})}
+
+
+def _dump(lips):
+    return lips if isinstance(lips, str) else lips.model_dump()
+
+
+def constriction_target(sym: str, p: Phoneme, inv: Inventory, area_cm2: float, lips, part: str = "") -> dict:
+    """A constriction target at the phoneme's place (the tract's place the inventory maps it to)."""
+    jaw = p.jaw if p.jaw is not None else inv.jaws.get(p.place)
+    if jaw is None:
+        raise ArticError(f"inventory: phonemes.{sym}: no jaw for place '{p.place}'; give it 'jaw' or add "
+                         f"jaws.{p.place}")
+    tol = inv.realisation.closure_tolerance_cm2 if area_cm2 == 0 else max(inv.realisation.channel_tolerance * area_cm2, 0.01)
+    t = {"name": f"{sym}{part}_{p.place}_{area_cm2:g}".replace(".", "p"), "jaw": jaw.model_dump(exclude_none=True),
+         "constriction": {"place": inv.places[p.place], "area_cm2": float(area_cm2), "tolerance_cm2": round(tol, 6)}}
+    if lips is not None:
+        t["lips"] = _dump(lips)
+    return t
+
+
+def _next_vowel(symbols: list[str], k: int, inv: Inventory) -> Phoneme | None:
+    for s in symbols[k + 1:]:
+        if s is not None and inv.phonemes[s].manner == "vowel":
+            return inv.phonemes[s]
+    return None
+
+
+def _next_consonant(symbols: list[str], k: int, inv: Inventory) -> str | None:
+    s = symbols[k + 1] if k + 1 < len(symbols) else None
+    return s if s is not None and inv.phonemes[s].manner not in ("vowel", "geminate", "moraic_nasal") else None
+
+
+def _parts(sym: str, p: Phoneme, inv: Inventory, lips) -> list[tuple[dict | None, float]]:
+    """(target or None (hold the tongue), share of the duration) of each part of a consonant."""
+    if p.manner == "vowel":
+        return [(vowel_target(sym, p, inv), 1.0)]
+    if p.place in TONGUELESS:
+        tongue = None
+        if p.palatalized:  # the tongue body takes the palatal glide's place during the lips' or glottis' gesture
+            y = inv.phonemes["y"]
+            tongue = constriction_target(f"{sym}_y", y, inv, y.channel_cm2, lips)
+        return [(tongue, 1.0)]
+    closure = p.manner in ("stop", "nasal", "tap", "affricate")
+    first = constriction_target(sym, p, inv, 0.0 if closure else p.channel_cm2, lips)
+    out = [(first, 1.0)]
+    if p.manner == "affricate":
+        share = inv.realisation.affricate_closure_share
+        out = [(first, share), (constriction_target(sym, p, inv, p.channel_cm2, lips, "_release"), 1 - share)]
+    if p.palatalized:
+        y = inv.phonemes["y"]
+        share = inv.realisation.palatal_glide_share
+        out = [(t, s * (1 - share)) for t, s in out] + [
+            (constriction_target(f"{sym}_y", y, inv, y.channel_cm2, lips), share)]
+    return out
+
+
+def _stand_in(symbols: list[str], k: int, inv: Inventory) -> Phoneme:
+    """What the moraic nasal or the geminate at ``k`` is made as: N a nasal at the next consonant's place
+    (velar when none follows or the next one's place is glottal), Q the next consonant itself."""
+    nxt = _next_consonant(symbols, k, inv)
+    if symbols[k] == "Q":
+        if nxt is None:
+            raise ArticError(f"segments[{k}]: the geminate Q needs a consonant after it (e.g. 'aQta')")
+        return inv.phonemes[nxt]
+    place = inv.phonemes[nxt].place if nxt is not None else None
+    n = inv.phonemes["m" if place == "bilabial" else "n"]
+    place = "velar" if place in (None, "glottal") else place
+    return n if n.place == place else n.model_copy(update={"place": place, "lips": "neutral"})
+
+
+def realise(u: Utterance, inv: Inventory, default_lips: tuple[float, float]) -> Utterance:
+    """The utterance with every ``phoneme`` segment made into target and hold segments and tract entries
+    (``default_lips``: the config's lip tube, area cm^2 and length cm, for neutral lips)."""
+    if not any(s.phoneme is not None for s in u.segments):
+        return u
+    symbols = [s.phoneme for s in u.segments]
+    for k, s in enumerate(symbols):
+        if s is not None and s not in inv.phonemes:
+            raise ArticError(f"segments[{k}].phoneme: '{s}' is not in the inventory; symbols: "
+                             f"{' '.join(inv.phonemes)}")
+    segments, tract, t = [], list(u.tract), 0.0
+    nasal_runs = []
+    for k, seg in enumerate(u.segments):
+        if seg.phoneme is None:
+            segments.append(seg)
+            t += seg.duration_ms
+            continue
+        sym = seg.phoneme
+        p = _stand_in(symbols, k, inv) if sym in ("N", "Q") else inv.phonemes[sym]
+        nv = _next_vowel(symbols, k, inv)
+        lips = _lips(p) if p.lips != "neutral" else (_lips(nv) if nv is not None else None)
+        voiced = p.voiced if sym != "N" else True
+        glottis = p.glottis_cm2
+        for n, (target, share) in enumerate(_parts(sym, p, inv, lips)):
+            common = dict(duration_ms=seg.duration_ms * share, voiced=voiced, glottis_cm2=glottis,
+                          label=sym if n == 0 else None, continues=n > 0)
+            segments.append(Segment(target=target, **common) if target is not None else Segment(hold=True, **common))
+        if p.lips == "closed" or (p.place == "bilabial" and p.manner == "fricative"):
+            area = 0.0 if p.lips == "closed" else p.channel_cm2
+            tract.append(TractEntry(at_ms=max(t - inv.realisation.lip_closing_ms, 0.0), ramp_ms=inv.realisation.lip_closing_ms,
+                                    lip_area_cm2=area))
+            after = _lips(nv) if nv is not None else None
+            tube = _tube(after, default_lips)
+            if t + seg.duration_ms < u.duration_ms:
+                tract.append(TractEntry(at_ms=t + seg.duration_ms, ramp_ms=inv.realisation.lip_opening_ms,
+                                        lip_area_cm2=tube[0], lip_length_cm=tube[1]))
+        if p.velum_port_cm2 > 0:
+            nasal_runs.append((t, t + seg.duration_ms, p.velum_port_cm2))
+        t += seg.duration_ms
+    tract += _port_entries(nasal_runs, inv.realisation.nasal_margin_ms, u.duration_ms)
+    return u.model_copy(update={"segments": segments, "tract": tract})
+
+
+def _tube(lips, default_lips: tuple[float, float]) -> tuple[float, float]:
+    shape = LIP_SHAPES.get(lips) if isinstance(lips, str) else lips
+    return default_lips if shape is None else (float(shape.area_cm2), float(shape.length_cm))
+
+
+def _port_entries(runs: list[tuple[float, float, float]], margin_ms: float, total_ms: float) -> list[TractEntry]:
+    """The port opening ``margin_ms`` before each nasal run (adjacent nasals joined) and closing over as long
+    after it: open at the nasal's start, shut ``margin_ms`` after its end."""
+    joined: list[list[float]] = []
+    for a, b, area in runs:
+        if joined and abs(joined[-1][1] - a) < 1e-9:
+            joined[-1][1], joined[-1][2] = b, max(joined[-1][2], area)
+        else:
+            joined.append([a, b, area])
+    out = []
+    for a, b, area in joined:
+        start = max(a - margin_ms, 0.0)
+        out.append(TractEntry(at_ms=start, ramp_ms=a - start, velum_port_cm2=area))
+        if b < total_ms:
+            out.append(TractEntry(at_ms=b, ramp_ms=margin_ms, velum_port_cm2=0.0))
+    return out
+
+
+__all__ = ["realise", "vowel_target", "constriction_target"]
