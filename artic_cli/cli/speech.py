@@ -16,8 +16,13 @@ from .app import app, err_console, handle_errors, out_console, with_progress
 @app.command("speak")
 @handle_errors
 def speak_cmd(
-    utterance: Path = typer.Argument(..., help="Utterance file (YAML): segments (a target or forces, a duration), "
-                                               "an F0 contour, a lip and velum course."),
+    utterance: Optional[Path] = typer.Argument(None, help="Utterance file (YAML): segments (a phoneme, a target "
+                                                          "or forces, a duration), an F0 contour, a lip and velum "
+                                                          "course.  Or give --text."),
+    text: Optional[str] = typer.Option(None, "--text", help="Romaji to speak (e.g. 'aga'): the inventory's phones "
+                                                            "at their default durations."),
+    inventory: Optional[Path] = typer.Option(None, "--inventory", help="Phoneme inventory (default "
+                                                                       "configs/phonemes/japanese.yaml)."),
     out: Optional[Path] = typer.Option(None, "--out", help="Sound to write (WAV); the TextGrid and NAME.h5 go "
                                                            "beside it (default data/utterances/NAME.wav)."),
     maps: Path = typer.Option(paths.EPMAPS, "--maps", help="EP maps the targets are solved on."),
@@ -46,6 +51,13 @@ def speak_cmd(
 
     check_number("--budget", budget, ge=1)
     check_number("--jobs", jobs, ge=1)
+    if (utterance is None) == (text is None):
+        raise ArticError("give an utterance file or --text ROMAJI, one of them (e.g. artic speak --text aga)")
+    if text is not None:
+        from ..speech.inventory import DEFAULT, load_inventory
+        from ..speech.text import utterance_of_text
+
+        utterance = utterance_of_text(text, load_inventory(inventory or DEFAULT))
     if page is not None:  # the page's pictures are drawn beside it
         plot, animate = plot or page.with_suffix(".png"), animate or page.with_suffix(".gif")
     for opt, p, ext in (("--plot", plot, ".png"), ("--animate", animate, ".gif"), ("--html", page, ".html")):
@@ -54,7 +66,7 @@ def speak_cmd(
     say = lambda m: err_console.print(m, highlight=False)  # noqa: E731
     res = with_progress("simulating", lambda update: speak_stage.speak(
         utterance, out, maps, mesh, acoustic_maps, config, solutions, accept_nearest, budget, update, say, jobs,
-        dynamic))
+        dynamic, inventory))
     _report(res)
     if plot is not None or animate is not None:
         _draw(res.paths, plot, animate, mesh, config)
