@@ -83,6 +83,7 @@ class Inventory(Strict):
     sources: list[str] = []
     places: dict[Place, str]  # a phonetic place -> the tract's place (an area-law region, lips or glottis)
     jaws: dict[Place, JawSpec] = {}  # a consonant's jaw position at its place, unless its entry gives one
+    vowel_jaw_beside: dict[Place, JawSpec] = {}  # a vowel next to a consonant of this place: at most this open
     realisation: Realisation = Realisation()
     phonemes: dict[str, Phoneme]
 

@@ -30,8 +30,27 @@ def _lips(p: Phoneme):
     return None if p.lips in ("neutral", "closed") else p.lips
 
 
-def vowel_target(sym: str, p: Phoneme, inv: Inventory) -> dict:
-    return {"name": f"{sym}_vowel", "jaw": p.jaw.model_dump(exclude_none=True),
+def openness(jaw) -> float:
+    """How open a jaw given by forces is (N: JO minus JC)."""
+    f = jaw.forces_n or {}
+    return float(f.get("JO", 0.0)) - float(f.get("JC", 0.0))
+
+
+def vowel_jaw(p: Phoneme, beside: list[Phoneme], inv: Inventory):
+    """A vowel's jaw: its own, or no more open than ``vowel_jaw_beside`` allows next to a consonant's place
+    (the jaw raised for a vowel beside /t s/: Keating, Lindblom, Lubker & Gay 1994)."""
+    jaw = p.jaw
+    for c in beside:
+        cap = inv.vowel_jaw_beside.get(c.place) if c is not None else None
+        if cap is not None and jaw.forces_n is not None and openness(cap) < openness(jaw):
+            jaw = cap
+    return jaw
+
+
+def vowel_target(sym: str, p: Phoneme, inv: Inventory, beside: list[Phoneme] = ()) -> dict:
+    jaw = vowel_jaw(p, list(beside), inv)
+    name = f"{sym}_vowel" if jaw == p.jaw else f"{sym}_vowel_jaw_{openness(jaw):g}".replace(".", "p").replace("-", "m")
+    return {"name": name, "jaw": jaw.model_dump(exclude_none=True),
             "acoustic": {"formants_hz": list(p.formants_hz), "tolerance_pct": list(inv.realisation.vowel_tolerance_pct)},
             **({"lips": _dump(_lips(p))} if _lips(p) is not None else {})}
 
@@ -66,10 +85,11 @@ def _next_consonant(symbols: list[str], k: int, inv: Inventory) -> str | None:
     return s if s is not None and inv.phonemes[s].manner not in ("vowel", "geminate", "moraic_nasal") else None
 
 
-def _parts(sym: str, p: Phoneme, inv: Inventory, lips) -> list[tuple[dict | None, float]]:
-    """(target or None (hold the tongue), share of the duration) of each part of a consonant."""
+def _parts(sym: str, p: Phoneme, inv: Inventory, lips, beside=()) -> list[tuple[dict | None, float]]:
+    """(target or None (hold the tongue), share of the duration) of each part of a phoneme (``beside``: a
+    vowel's neighbouring consonants)."""
     if p.manner == "vowel":
-        return [(vowel_target(sym, p, inv), 1.0)]
+        return [(vowel_target(sym, p, inv, beside), 1.0)]
     if p.place in TONGUELESS:
         tongue = None
         if p.palatalized:  # the tongue body takes the palatal glide's place during the lips' or glottis' gesture
@@ -88,6 +108,20 @@ def _parts(sym: str, p: Phoneme, inv: Inventory, lips) -> list[tuple[dict | None
         out = [(t, s * (1 - share)) for t, s in out] + [
             (constriction_target(f"{sym}_y", y, inv, y.channel_cm2, lips), share)]
     return out
+
+
+def _neighbour(symbols: list[str], k: int, step: int, inv: Inventory) -> Phoneme | None:
+    """The consonant right before (``step`` -1) or after (+1) position ``k``, as it is made (N and Q stand in)."""
+    j = k + step
+    if not 0 <= j < len(symbols) or symbols[j] is None:
+        return None
+    p = inv.phonemes[symbols[j]]
+    if symbols[j] in ("N", "Q"):
+        try:
+            p = _stand_in(symbols, j, inv)
+        except ArticError:
+            return None
+    return None if p.manner == "vowel" else p
 
 
 def _stand_in(symbols: list[str], k: int, inv: Inventory) -> Phoneme:
@@ -127,7 +161,8 @@ def realise(u: Utterance, inv: Inventory, default_lips: tuple[float, float]) -> 
         lips = _lips(p) if p.lips != "neutral" else (_lips(nv) if nv is not None else None)
         voiced = p.voiced if sym != "N" else True
         glottis = p.glottis_cm2
-        for n, (target, share) in enumerate(_parts(sym, p, inv, lips)):
+        beside = [_neighbour(symbols, k, d, inv) for d in (-1, 1)] if p.manner == "vowel" else []
+        for n, (target, share) in enumerate(_parts(sym, p, inv, lips, beside)):
             common = dict(duration_ms=seg.duration_ms * share, voiced=voiced, glottis_cm2=glottis,
                           label=sym if n == 0 else None, continues=n > 0)
             segments.append(Segment(target=target, **common) if target is not None else Segment(hold=True, **common))

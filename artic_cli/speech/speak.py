@@ -167,24 +167,35 @@ class Laps:
         self.clock = now
 
 
-def move(model: Model, c: Course, cfg: Config, lap: Laps, progress=None) -> tuple[Trajectory, np.ndarray, float]:
-    """The course simulated from the rest posture: the trajectory (its clock at the sound's start), where
-    each segment's forces lead (cm) and how far any node got beyond the wall (cm)."""
-    sp = cfg.speech
+def course_trajectory(model: Model, c: Course, cfg: Config, rest, progress=None, lap=None) -> Trajectory:
+    """The course simulated from ``rest``: the lead-in, then the sound's frames (its clock at the sound's
+    start)."""
     zero = np.zeros((model.n_nodes, 3))
-    rest = settle(model)
-    lap("rest posture")
     dt = units.ms_to_s(cfg.simulation.dt_ms)
-    eps = equilibria(model, rest, c.vectors, units.ms_to_s(sp.reach_hold_ms), dt)
-    lap("segment EPs")
     start = rest
     if c.prep_s > 0:  # the lead-in: the first segment's forces act before the sound starts
         _, start = run(model, rest, lambda t: Control(node_force=zero, muscle_force=c.force_at(t)), c.prep_s, dt)
         start = replace(start, t=0.0)
-        lap("lead-in")
-    every = max(1, int(round(units.ms_to_s(sp.frame_ms) / dt)))
+        if lap is not None:
+            lap("lead-in")
+    every = max(1, int(round(units.ms_to_s(cfg.speech.frame_ms) / dt)))
     traj, _ = run(model, start, lambda t: Control(node_force=zero, muscle_force=c.force_at(t + c.prep_s)),
                   c.duration_s, dt, record_every=every, progress=progress, keep_partial=True)
+    return traj
+
+
+def move(model: Model, c: Course, cfg: Config, lap: Laps, progress=None, rest=None
+         ) -> tuple[Trajectory, np.ndarray, float]:
+    """The course simulated from the rest posture (``rest``, settled here if not given): the trajectory (its
+    clock at the sound's start), where each segment's forces lead (cm) and how far any node got beyond the
+    wall (cm)."""
+    sp = cfg.speech
+    rest = settle(model) if rest is None else rest
+    lap("rest posture")
+    dt = units.ms_to_s(cfg.simulation.dt_ms)
+    eps = equilibria(model, rest, c.vectors, units.ms_to_s(sp.reach_hold_ms), dt)
+    lap("segment EPs")
+    traj = course_trajectory(model, c, cfg, rest, progress, lap)
     lap("simulation")
     beyond = 0.0
     if model.contact is not None:  # how far any contact node got beyond the wall (cm)
@@ -246,11 +257,12 @@ def sound(u: Utterance, p: Plan, tracts: Tracts, time_s: np.ndarray, duration_s:
     return out.audio, tb, glottis, air
 
 
-def speak_plan(u: Utterance, p: Plan, cfg: Config, model: Model, progress=None) -> Spoken:
-    """Simulate the plan's force course on ``model`` from the rest posture and voice it."""
+def speak_plan(u: Utterance, p: Plan, cfg: Config, model: Model, progress=None, rest=None) -> Spoken:
+    """Simulate the plan's force course on ``model`` from the rest posture (``rest``, if settled already) and
+    voice it."""
     c = force_course(u, p, model, cfg)
     lap = Laps()
-    traj, eps, beyond = move(model, c, cfg, lap, progress)
+    traj, eps, beyond = move(model, c, cfg, lap, progress, rest)
     bad = problems(traj, model.volume_constraint)
     if bad:
         raise NotPhysical(f"utterance '{u.name}': the simulation is not physical ({'; '.join(bad)}); nothing written")

@@ -23,6 +23,7 @@ from ..io.fingerprint import digest
 from ..io.store import atomic_h5, open_artifact, stored_content_hash
 from ..io.wav import write_wav
 from ..mechanics.model import ARTICULATOR_SECTIONS
+from ..mechanics.simulate import settle
 from ..speech.plan import Plan, needs_dynamic, plan, segment_targets
 from ..speech.record import Record
 from ..speech.speak import Spoken, speak_plan
@@ -30,6 +31,7 @@ from ..speech.textgrid import write_textgrid
 from ..speech.inventory import DEFAULT as DEFAULT_INVENTORY
 from ..speech.inventory import load_inventory
 from ..speech.phones import realise
+from ..speech.timing import timed
 from ..speech.utterance import Utterance, check_forces, load_utterance
 from ..tract.places import section_places
 from ..tract.speaker import speaker_tract
@@ -224,6 +226,12 @@ def speak(utterance: Path | str | Utterance, out: Path | str | None = None, maps
     solve = partial(solve_runs.solve_batch, maps=maps, mesh=mesh, acoustic_maps=acoustic_maps, config=config,
                     folder=folder, budget=budget, jobs=jobs,
                     dynamic=dynamic if dynamic is not None and needs_dynamic(targets, cfg) else None)
-    p = plan(u, STAGE.view(cfg), targets, solve, accept_nearest, say)
-    s = speak_plan(u, p, STAGE.view(cfg), model, progress)
+    view = STAGE.view(cfg)
+    p = plan(u, view, targets, solve, accept_nearest, say)
+    rest = settle(model)
+    u, timing = timed(u, p, view, model, rest, targets)
+    if timing is not None and say:
+        say(f"timing: {timing.rounds} round(s); leads {', '.join(f'{v:.0f}' for v in timing.leads_ms)} ms; "
+            f"presses {', '.join(f'{v:.2f}' for v in timing.press)}")
+    s = speak_plan(u, p, view, model, progress, rest)
     return SpeakResult(write(out, s, prov), s)

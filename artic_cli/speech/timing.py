@@ -1,0 +1,146 @@
+"""Gesture timing from the model's own movement: each constriction segment's forces switch on early enough,
+and press hard enough, that the model makes the constriction inside its interval, and the segment after it
+switches on late enough that it holds to the interval's end (docs/inventory.md, "Timing").
+
+The utterance is simulated (mechanics and area function only, no sound), the area at each constriction's
+place read frame by frame, and the leads and presses moved by what was measured: a constriction reached
+``late`` ms after its start leads by that much more; one never reached presses harder (its tongue forces x
+``PRESS_STEP``, at most ``PRESS_MAX``) and leads ``LEAD_STEP_MS`` more; one released before its end (or, never
+made, narrowest before its end) delays the next segment's switch by as much.  Leads keep the switches in order (``MIN_GAP_MS`` apart); a segment whose
+lead or press the utterance gives is left as given.  A few rounds settle it; what each round measured is
+returned for the record.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..config import Config
+from ..control.solver import TargetSpec
+from ..mechanics.model import Model
+from ..tract.places import place_area, place_index, section_places
+from ..tract.speaker import speaker_tract
+from .plan import Plan
+from .speak import course_trajectory, force_course, tracts_of_run
+from .utterance import Utterance
+
+ROUNDS = 6
+SLACK_MS = 3.0  # reached within this of the start, held to within this of the end: on time
+PRESS_STEP, PRESS_MAX = 1.15, 2.0
+LEAD_STEP_MS, LEAD_MAX_MS, MIN_GAP_MS = 20.0, 250.0, 10.0
+WINDOW_MS = 20.0  # a constriction made this long before its interval counts as reached at its start
+
+
+@dataclass
+class Goal:
+    segment: int
+    place: int  # index of the tract's place
+    reach_cm2: float  # reached at or below this area
+
+
+@dataclass
+class Timing:
+    leads_ms: list[float]
+    press: list[float]
+    rounds: int
+    onset_late_ms: dict[int, float]  # per constriction segment: when its constriction was first made (NaN: never)
+    released_early_ms: dict[int, float]  # ... how long before its end it opened again
+
+
+def goals_of(targets: list[TargetSpec | None], cfg: Config) -> list[Goal]:
+    """A goal per segment whose target is a constriction at a place of the tract."""
+    _, names = section_places(speaker_tract(cfg))
+    out = []
+    for k, t in enumerate(targets):
+        if t is not None and t.constriction is not None and t.constriction.place in names:
+            c = t.constriction
+            out.append(Goal(k, place_index(names, c.place), float(c.area_cm2 + c.tolerance_cm2)))
+    return out
+
+
+def place_areas(u: Utterance, p: Plan, cfg: Config, model: Model, rest, goals: list[Goal]):
+    """(frame times s, {segment: its place's area per frame, cm^2}) of the utterance simulated."""
+    c = force_course(u, p, model, cfg)
+    traj = course_trajectory(model, c, cfg, rest)
+    tracts = tracts_of_run(u, p, model, traj, cfg)
+    region, _ = section_places(speaker_tract(cfg))
+    return traj.time, {g.segment: place_area(tracts.af.area_cm2, region, g.place) for g in goals}
+
+
+def onset_and_release(t: np.ndarray, area: np.ndarray, reach: float, start: float, end: float):
+    """(ms after ``start`` the constriction is first made, NaN if never before ``end``; ms before ``end`` it opens
+    again, 0 if it holds; when never made, ms before ``end`` the area was narrowest: where it turned back)."""
+    ok = area <= reach
+    window = (t >= start - WINDOW_MS / 1e3) & (t < end)
+    hit = np.flatnonzero(ok & window)
+    if not len(hit):
+        inside = np.flatnonzero(window)
+        if not len(inside):
+            return float("nan"), 0.0
+        return float("nan"), 1e3 * (end - float(t[inside[np.argmin(area[inside])]]))
+    onset = max(float(t[hit[0]]) - start, 0.0)
+    after = np.flatnonzero(~ok & (t > t[hit[0]]) & (t < end))
+    released = end - float(t[after[0]]) if len(after) else 0.0
+    return 1e3 * onset, 1e3 * released
+
+
+def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[TargetSpec | None],
+          rounds: int = ROUNDS) -> tuple[Utterance, Timing | None]:
+    """The utterance with the leads and presses its constrictions need (see the module's text); unchanged, with
+    no timing, when it asks for no constriction."""
+    goals = goals_of(targets, cfg)
+    if not goals:
+        return u, None
+    segs = u.segments
+    leads = np.array(u.leads_ms(cfg.speech.lead_ms), float)
+    press = np.array([s.press for s in segs], float)
+    free_lead = [s.lead_ms is None for s in segs]
+    free_press = [s.press == 1.0 for s in segs]
+    starts = np.array(u.starts_ms(), float)
+    ends = starts + np.array([s.duration_ms for s in segs])
+    late, early = {}, {}
+    for r in range(rounds):
+        trial = _with(u, leads, press)
+        t, areas = place_areas(trial, p, cfg, model, rest, goals)
+        changed = False
+        for g in goals:
+            k = g.segment
+            on, off = onset_and_release(t, areas[g.segment], g.reach_cm2, starts[k] / 1e3, ends[k] / 1e3)
+            late[k], early[k] = on, off
+            if not np.isfinite(on):
+                if free_press[k] and press[k] < PRESS_MAX:
+                    press[k] = min(press[k] * PRESS_STEP, PRESS_MAX)
+                    changed = True
+                changed |= _lead_more(leads, starts, k, LEAD_STEP_MS, free_lead)
+            elif on > SLACK_MS:
+                changed |= _lead_more(leads, starts, k, on, free_lead)
+            if off > SLACK_MS and k + 1 < len(segs) and free_lead[k + 1] and leads[k + 1] > 0:
+                leads[k + 1] = max(leads[k + 1] - off, 0.0)
+                changed = True
+        if not changed:
+            break
+    return _with(u, leads, press), Timing(leads_ms=leads.tolist(), press=press.tolist(), rounds=r + 1,
+                                          onset_late_ms=late, released_early_ms=early)
+
+
+def _lead_more(leads: np.ndarray, starts: np.ndarray, k: int, by_ms: float, free: list[bool]) -> bool:
+    """Segment ``k`` leads ``by_ms`` more, as far as the switch before it and ``LEAD_MAX_MS`` allow."""
+    if not free[k] or k == 0:
+        return False
+    limit = min(LEAD_MAX_MS, starts[k] - (starts[k - 1] - leads[k - 1]) - MIN_GAP_MS)
+    new = min(leads[k] + by_ms, limit)
+    if new <= leads[k] + 0.5:
+        return False
+    leads[k] = new
+    return True
+
+
+def _with(u: Utterance, leads, press) -> Utterance:
+    segs = [s.model_copy(update={"lead_ms": round(float(a), 3), "press": round(float(b), 4)})
+            for s, a, b in zip(u.segments, leads, press)]
+    return u.model_copy(update={"segments": segs})
+
+
+__all__ = ["Goal", "Timing", "goals_of", "onset_and_release", "timed"]
