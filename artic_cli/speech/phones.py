@@ -170,6 +170,8 @@ def realise(u: Utterance, inv: Inventory, default_lips: tuple[float, float]) -> 
             area = 0.0 if p.lips == "closed" else p.channel_cm2
             tract.append(TractEntry(at_ms=max(t - inv.realisation.lip_closing_ms, 0.0), ramp_ms=inv.realisation.lip_closing_ms,
                                     lip_area_cm2=area))
+            # ... and stay so at its start, whatever lips a tongue target of its own (/py/'s glide) brings
+            tract.append(TractEntry(at_ms=t, ramp_ms=0.0, lip_area_cm2=area))
             after = _lips(nv) if nv is not None else None
             tube = _tube(after, default_lips)
             if t + seg.duration_ms < u.duration_ms:

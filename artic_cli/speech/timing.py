@@ -100,6 +100,9 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
     free_press = [s.press == 1.0 for s in segs]
     starts = np.array(u.starts_ms(), float)
     ends = starts + np.array([s.duration_ms for s in segs])
+    for k in range(1, len(segs)):  # a short part (an affricate's release, a glide) leads no more than fits
+        if free_lead[k]:
+            leads[k] = max(min(leads[k], starts[k] - (starts[k - 1] - leads[k - 1]) - MIN_GAP_MS), 0.0)
     late, early = {}, {}
     for r in range(rounds):
         trial = _with(u, leads, press)

@@ -76,6 +76,7 @@ STAGES: tuple[StageEntry, ...] = (
                "--config {config} --acoustic-maps {out}/acoustic_maps.h5 --accept-nearest "
                "--out {out}/utterances/{name}.wav",
                inputs=(MAPS, DYN, MESH, "{out}/acoustic_maps.h5", "configs/utterances/{name}.yaml",
+                       "configs/phonemes/japanese.yaml",
                        "$(wildcard configs/targets/vowels/*.yaml configs/targets/consonants/*.yaml)"),
                items="utterances",
                figures=(Figure("{report}/utterance_{name}.png", "plot utterance {output}", "--out {figure}",
