@@ -300,3 +300,44 @@ def test_every_source_switches_off(tmp_path, mesh_file, spoken):
     # without the nasal branch the /m/ is the closed tract's voice bar alone: far weaker than the murmur
     assert praat_level_db(tmp_path / "m.wav", t0 + 0.01, t1 - 0.01) < praat_level_db(spoken / "ama.wav", t0 + 0.01,
                                                                                      t1 - 0.01) - 10
+
+
+@pytest.mark.parametrize("c, manner", [("m", "nasal"), ("n", "nasal"), ("b", "stop"), ("p", "stop"),
+                                       ("h", "fricative"), ("t", "stop")])
+def test_the_reports_landmarks_measure_what_praat_hears(spoken, c, manner):
+    """speech/landmarks.py (numpy, what the report tables) against Praat on the same WAVs: levels within 2 dB,
+    band ratios within 3 dB (Praat's Hann band filter has 100-Hz skirts, Welch's bands are sharp: at a 500-Hz
+    edge beside a murmur's strong low band the two part by about 2 dB), the closure on the same side of its
+    goal."""
+    from artic_cli.io.wav import read_wav
+    from artic_cli.speech.landmarks import measure
+
+    wav = spoken / f"a{c}a.wav"
+    y, rate = read_wav(wav)
+    m = measure(y, rate, (C0, C1, c), [V1, V2], manner)
+    assert abs(m["level_db"] - (praat_level_db(wav, C0, C1) - _vowels_db(wav))) <= 2.0
+    if manner == "nasal":
+        a, b = C0 + 0.25 * (C1 - C0), C1 - 0.25 * (C1 - C0)
+        praat = (_band_db(wav, a, b, 0, 500) - _band_db(wav, a, b, 500, 4000)
+                 - (_vowels_db(wav, 0, 500) - _vowels_db(wav, 500, 4000)))
+        assert abs(m["low_ratio_db"] - praat) <= 3.0, (m["low_ratio_db"], praat)
+    if manner == "fricative":
+        a, b = C0 + 0.2 * (C1 - C0), C1 - 0.2 * (C1 - C0)
+        praat = _band_db(wav, a, b, 1000, 8000) - _vowels_db(wav, 1000, 8000)
+        assert abs(m["band_1_8k_db"] - praat) <= 2.0, (m["band_1_8k_db"], praat)
+    if manner == "stop" and c != "b":
+        assert m["closure_ms"] >= 25 and praat_level_db(wav, C0 + 0.02, C1 - 0.02) - _vowels_db(wav) <= -25
+
+
+@pytest.mark.parametrize("c", ["m", "n", "h", "t", pytest.param("b", marks=pytest.mark.xfail(
+    strict=True, reason="our frames call the closure's first 15 ms voiced (25 % of it), Praat's path finder "
+                        "6 %: docs/inventory.md, Landmarks")), pytest.param("p", marks=pytest.mark.xfail(
+    strict=True, reason="as /b/: 25 % against Praat's 6 %"))])
+def test_the_reports_voicing_is_praats_within_0_15(spoken, c):
+    from artic_cli.io.wav import read_wav
+    from artic_cli.speech.landmarks import share_voiced
+
+    wav = spoken / f"a{c}a.wav"
+    y, rate = read_wav(wav)
+    ours, praat = share_voiced(y, rate, C0, C1), _voiced(wav, C0, C1)
+    assert abs(ours - praat) <= 0.15, (ours, praat)
