@@ -127,11 +127,12 @@ def landmark_table(records) -> tuple[list[str], list[Row]]:
     from ..speech.landmarks import consonants
 
     manners = {k: p.manner for k, p in load_inventory().phonemes.items()}
-    head = ("| utterance | phone | ms | closure ms | closure dB | closure voiced | voiced | level dB | low ratio dB | "
-            "3-8 kHz dB | centroid Hz | dip dB | F2 Hz | checks |")
     out = ["Each consonant's acoustic landmarks (dB against the vowels beside it; voicing as a share of frames; "
-           "`speech/landmarks.py`, held to Praat in the tests) and the checks of its manner (failed ones named):",
-           "", head, "|" + "---|" * 14]
+           "`speech/landmarks.py`, held to Praat in the tests) and the checks of its manner (failed ones named):", ""]
+    names = {"closure_ms": "closure {} ms", "closure_db": "at {} dB", "closure_voiced": "closure voiced {}",
+             "voiced_share": "voiced {}", "level_db": "level {} dB", "low_ratio_db": "low ratio {} dB",
+             "band_3_8k_db": "3-8 kHz {} dB", "centroid_hz": "centroid {} Hz", "dip_db": "dip {} dB",
+             "f2_hz": "F2 {} Hz"}
     passed = total = 0
     for path, rec in records:
         tg = path.with_suffix(".TextGrid")
@@ -147,11 +148,12 @@ def landmark_table(records) -> tuple[list[str], list[Row]]:
             cells = []
             for c in LANDMARK_COLUMNS:
                 v = m.get(c)
-                cells.append("" if v is None or not np.isfinite(v) else (f"{100 * v:.0f} %" if c in (
-                    "closure_voiced", "voiced_share") else f"{v:.0f}"))
+                if v is not None and np.isfinite(v):
+                    cells.append(names[c].format(f"{100 * v:.0f} %" if c in ("closure_voiced", "voiced_share")
+                                                 else f"{v:.0f}"))
             failed = [k for k, v in m["checks"].items() if not v]
-            out.append(f"| /{rec.attrs.get('name', path.stem)}/ | {m['symbol']} | {m['duration_ms']:.0f} | "
-                       + " | ".join(cells) + " | " + ("pass" if ok else "fails " + "; ".join(failed)) + " |")
+            out.append(f"* /{rec.attrs.get('name', path.stem)}/ {m['symbol']} ({m['duration_ms']:.0f} ms): "
+                       + ", ".join(cells) + "; " + ("passes" if ok else "fails " + "; ".join(failed)))
     if not total:
         return [], []
     row = Row("Consonant landmarks (issue 45's checks, every consonant spoken)", "every consonant passes its manner's "
