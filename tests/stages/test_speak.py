@@ -454,3 +454,11 @@ def test_a_spoken_utterance_gets_a_page_to_look_at_and_listen_to(spoken, mesh_fi
     assert [src for src, _ in got["images"]] == ["lab_page.png", "lab_page.gif"] and all(w > 0 for _, w in got["images"])
     assert got["audio"] == [["lab.wav", pytest.approx(1.0, abs=0.01), 0]]
     assert text.count("<tr>") == 7  # a header and the six segments
+
+
+@pytest.mark.parametrize("args, says", [(["--text", "ax"], "'x' at position 2 is not in the inventory"),
+                                        (["--text", "   "], "give some romaji"), ([], "give an utterance file or --text")])
+def test_bad_text_is_one_line_and_exit_2_with_nothing_written(tmp_path, mesh_file, args, says):
+    res = _run("speak", *args, "--mesh", mesh_file, "--out", tmp_path / "out" / "x.wav", "--maps", tmp_path / "none.h5")
+    assert res.exit_code == 2 and says in res.output and "Traceback" not in res.output, res.output
+    assert not (tmp_path / "out").exists()
