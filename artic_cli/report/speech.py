@@ -111,13 +111,6 @@ LANDMARK_COLUMNS = ("closure_ms", "closure_db", "closure_voiced", "voiced_share"
                     "band_3_8k_db", "centroid_hz", "dip_db", "f2_hz")
 
 
-def _phones(path: Path) -> list[tuple[float, float, str]]:
-    from praatio import textgrid
-
-    tg = textgrid.openTextgrid(str(path), includeEmptyIntervals=False)
-    return [(e.start, e.end, e.label) for e in tg.getTier(tg.tierNames[0]).entries]
-
-
 def landmark_table(records) -> tuple[list[str], list[Row]]:
     """Every consonant of the utterances spoken through the inventory: its landmarks against the vowels beside
     it (speech/landmarks.py; closure ms and dB, voicing in the closure and overall, level, murmur's low ratio,
@@ -125,6 +118,7 @@ def landmark_table(records) -> tuple[list[str], list[Row]]:
     from ..io.wav import read_wav
     from ..speech.inventory import load_inventory
     from ..speech.landmarks import consonants
+    from ..speech.textgrid import read_phones
 
     manners = {k: p.manner for k, p in load_inventory().phonemes.items()}
     out = ["Each consonant's acoustic landmarks (dB against the vowels beside it; voicing as a share of frames; "
@@ -138,7 +132,7 @@ def landmark_table(records) -> tuple[list[str], list[Row]]:
         tg = path.with_suffix(".TextGrid")
         if not tg.is_file():
             continue
-        iv = _phones(tg)
+        iv = read_phones(tg)
         if not any(manners.get(lab) not in (None, "vowel") for _, _, lab in iv):
             continue
         y, rate = read_wav(path.with_suffix(".wav"))

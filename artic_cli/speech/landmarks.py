@@ -14,11 +14,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from scipy.signal import welch
-
-from ..acoustics.measures import runs
+from ..acoustics.measures import band_power_db, runs
 
 FLOOR_DB = -150.0  # digital silence
+VOICED_STOPS = ("b", "d", "g", "gy", "by")  # judged by a shallower closure with voicing in it
 RMS_MS, STEP_MS = 5.0, 1.0
 
 
@@ -58,22 +57,6 @@ def voiced_frames(x: np.ndarray, rate: int, f_lo: float = 75.0, f_hi: float = 40
     return np.array(times), np.array(out)
 
 
-def band_level_db(x: np.ndarray, rate: int, t0: float, t1: float, lo: float = 0.0, hi: float | None = None) -> float:
-    """The mean power of [t0, t1) in [lo, hi) Hz, dB re a full-scale sine's: all of it a plain mean square (as
-    Praat's intensity), a band from Welch's averaged periodogram (every instant weighed alike, little leakage)."""
-    a, b = max(int(round(t0 * rate)), 0), int(round(t1 * rate))
-    seg = np.asarray(x[a:max(b, a + 1)], float)
-    if len(seg) < 16:
-        return float("nan")
-    if lo <= 0 and hi is None:
-        power = float(np.mean(seg ** 2))
-    else:
-        f, pxx = welch(seg, rate, nperseg=min(512, len(seg)), noverlap=None, detrend=False)
-        keep = (f >= lo) & (f < (hi if hi is not None else np.inf))
-        power = float(np.sum(pxx[keep]) * (f[1] - f[0]))
-    return 10.0 * np.log10(max(power, 1e-30) / 0.5)
-
-
 EDGE_S = 0.01  # a frame centred this near an interval's edge reaches a quarter of its window over it
 
 
@@ -93,7 +76,7 @@ def _mid(iv):
 
 def low_ratio_db(x, rate, t0, t1) -> float:
     """Energy below 500 Hz against 500-4000 Hz (dB)."""
-    return band_level_db(x, rate, t0, t1, 0.0, 500.0) - band_level_db(x, rate, t0, t1, 500.0, 4000.0)
+    return band_power_db(x, rate, t0, t1, 0.0, 500.0) - band_power_db(x, rate, t0, t1, 500.0, 4000.0)
 
 
 def centroid_hz(x, rate, t0, t1, lo=1000.0, hi=10000.0) -> float:
@@ -111,9 +94,9 @@ def vowel_reference(x, rate, vowels: list[tuple[float, float]]) -> dict:
     """The neighbouring vowels' mean level overall, 3-8 kHz, 1-8 kHz, and their low-frequency ratio (dB)."""
     mids = [_mid(v) for v in vowels]
     mean = lambda f: float(np.mean([f(a, b) for a, b in mids]))  # noqa: E731
-    return {"level_db": mean(lambda a, b: band_level_db(x, rate, a, b)),
-            "band_3_8k_db": mean(lambda a, b: band_level_db(x, rate, a, b, 3000.0, 8000.0)),
-            "band_1_8k_db": mean(lambda a, b: band_level_db(x, rate, a, b, 1000.0, 8000.0)),
+    return {"level_db": mean(lambda a, b: band_power_db(x, rate, a, b)),
+            "band_3_8k_db": mean(lambda a, b: band_power_db(x, rate, a, b, 3000.0, 8000.0)),
+            "band_1_8k_db": mean(lambda a, b: band_power_db(x, rate, a, b, 1000.0, 8000.0)),
             "low_ratio_db": mean(lambda a, b: low_ratio_db(x, rate, a, b))}
 
 
@@ -132,20 +115,20 @@ def closure(t, db, t0, t1, below_db, margin_s=0.015):
 
 
 def measure(x, rate, iv: tuple[float, float, str], vowels: list[tuple[float, float]], manner: str,
-            formants=None, frames=None) -> dict:
+            formants=None, frames=None, contour=None) -> dict:
     """The landmarks of the consonant interval ``iv`` (start s, end s, symbol) of manner ``manner``, against the
     ``vowels`` (start s, end s) beside it; ``formants``: (times s, (F, 2) F1 F2 Hz) for a glide's F2."""
     t0, t1, sym = iv
     frames = voiced_frames(x, rate) if frames is None else frames
     ref = vowel_reference(x, rate, vowels)
-    t, db = rms_contour_db(x, rate)
+    t, db = rms_contour_db(x, rate) if contour is None else contour
     out = {"symbol": sym, "manner": manner, "duration_ms": 1e3 * (t1 - t0),
            "voiced_share": share_voiced(x, rate, t0, t1, frames),
-           "level_db": band_level_db(x, rate, t0, t1) - ref["level_db"]}
+           "level_db": band_power_db(x, rate, t0, t1) - ref["level_db"]}
     inside = (t >= t0) & (t <= t1)
     out["dip_db"] = float(db[inside].min() - ref["level_db"]) if inside.any() else float("nan")
     if manner in ("stop", "affricate"):
-        depth = 12.0 if manner == "stop" and sym in ("b", "d", "g", "gy", "by") else (
+        depth = 12.0 if manner == "stop" and sym in VOICED_STOPS else (
             20.0 if manner == "affricate" else 25.0)
         c = closure(t, db, t0, t1, ref["level_db"] - depth)
         if c is None:
@@ -161,8 +144,8 @@ def measure(x, rate, iv: tuple[float, float, str], vowels: list[tuple[float, flo
     if manner in ("fricative", "affricate"):
         a = t0 + 0.6 * (t1 - t0) if manner == "affricate" else t0 + 0.2 * (t1 - t0)
         b = t1 if manner == "affricate" else t1 - 0.2 * (t1 - t0)
-        out["band_3_8k_db"] = band_level_db(x, rate, a, b, 3000.0, 8000.0) - ref["band_3_8k_db"]
-        out["band_1_8k_db"] = band_level_db(x, rate, a, b, 1000.0, 8000.0) - ref["band_1_8k_db"]
+        out["band_3_8k_db"] = band_power_db(x, rate, a, b, 3000.0, 8000.0) - ref["band_3_8k_db"]
+        out["band_1_8k_db"] = band_power_db(x, rate, a, b, 1000.0, 8000.0) - ref["band_1_8k_db"]
         out["centroid_hz"] = centroid_hz(x, rate, a, b)
     if manner == "approximant" and formants is not None:
         ft, fm = formants
@@ -178,7 +161,7 @@ VOICED_FRICATIVES = ("z", "j")
 def criteria(m: dict) -> dict[str, bool]:
     """Each check of the consonant's manner (issue 45's thresholds) on its landmarks ``m``."""
     sym, man = m["symbol"], m["manner"]
-    voiced_stop = sym in ("b", "d", "g", "gy", "by")
+    voiced_stop = sym in VOICED_STOPS
     c: dict[str, bool] = {}
     if man == "stop" and not voiced_stop:
         c["closure >= 25 ms at -25 dB"] = m["closure_ms"] >= 25.0
@@ -219,6 +202,7 @@ def consonants(x, rate, intervals: list[tuple[float, float, str]], manners: dict
                frames=None) -> list[dict]:
     """The landmarks and checks of every consonant interval with a vowel on each side (or one, at an edge)."""
     frames = voiced_frames(x, rate) if frames is None else frames
+    contour = rms_contour_db(x, rate)
     out = []
     for k, iv in enumerate(intervals):
         man = manners.get(iv[2])
@@ -229,7 +213,7 @@ def consonants(x, rate, intervals: list[tuple[float, float, str]], manners: dict
         vowels = [v for v in (before, after) if v is not None]
         if not vowels:
             continue
-        m = measure(x, rate, iv, vowels, man, formants, frames)
+        m = measure(x, rate, iv, vowels, man, formants, frames, contour)
         m["checks"] = criteria(m)
         out.append(m)
     return out

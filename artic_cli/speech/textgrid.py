@@ -33,3 +33,12 @@ def write_textgrid(path: Path | str, p) -> Path:
     with atomic_path(path, ".TextGrid") as tmp:
         tg.save(str(tmp), format="long_textgrid", includeBlankSpaces=True)
     return Path(path)
+
+
+def read_phones(path: Path | str) -> list[tuple[float, float, str]]:
+    """(start s, end s, label) of the first tier's non-empty intervals (the tier 'phones' of a spoken record)."""
+    from praatio import textgrid
+
+    tg = textgrid.openTextgrid(str(path), includeEmptyIntervals=False)
+    return [(e.start, e.end, e.label) for e in tg.getTier(tg.tierNames[0]).entries]
+
