@@ -70,7 +70,7 @@ test: setup
 test-fast: setup
 	$(PY) -m pytest -m "not slow"
 
-bench: setup $(OUT)/epmaps.h5 $(OUT)/dynamic.h5
+bench: setup $(OUT)/epmaps.h5 $(OUT)/dynamic.h5 $(OUT)/acoustic_maps.h5
 	$(PY) benchmarks/run_all.py --out docs/speed.md
 
 clean:

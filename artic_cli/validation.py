@@ -14,9 +14,17 @@ import math
 import re
 from typing import Annotated, Any
 
+import yaml
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationError, ValidationInfo
 
 from .errors import ArticError
+
+YAML_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml's, where PyYAML was built with it: 5x faster
+
+
+def load_yaml(text: str) -> Any:
+    """YAML text as Python objects (the safe loader: no tags that build objects)."""
+    return yaml.load(text, Loader=YAML_LOADER)
 
 DEFAULT_MAX_FORCE_N = 50.0  # the largest muscle or load force accepted unless the config's muscles.max_force_n raises it
 

@@ -20,7 +20,8 @@ BENCHES = [("Tongue alone (section II)", "bench_tissue.py"), ("Whole articulator
            ("EP maps (section IV.B)", "bench_epmap.py"), ("Target solver (section V)", "bench_solver.py"),
            ("Acoustics (tubes)", "bench_acoustics.py"), ("Vocal tract (area functions)", "bench_vocal_tract.py"),
            ("Vowels (acoustic maps, formant targets)", "bench_vowels.py"),
-           ("Utterances (simulation and sound of 1 s of speech)", "bench_speak.py")]
+           ("Utterances (simulation and sound of 1 s of speech)", "bench_speak.py"),
+           ("Speaking from text (artic speak --text aga)", "bench_speak_text.py")]
 
 
 def main() -> int:

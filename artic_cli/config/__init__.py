@@ -16,7 +16,7 @@ import yaml
 from pydantic import ValidationError
 
 from ..errors import ArticError
-from ..validation import Strict, describe, parse
+from ..validation import Strict, describe, load_yaml, parse
 from .body import *  # noqa: F401,F403  (every section's schema, importable from artic_cli.config)
 from .body import (Contact, Cuboid, EPMapSpec, Jaw, Materials, MuscleFunctionSpec, Muscles, Simulation, SolverSpec,
                    Speaker)
@@ -58,7 +58,7 @@ def read_yaml(path: Path | str, what: str = "file") -> object:
     if not path.is_file():
         raise ArticError(f"{what} not found: {path}; give an existing path")
     try:
-        return yaml.safe_load(path.read_text())
+        return load_yaml(path.read_text())
     except yaml.YAMLError as err:
         mark = getattr(err, "problem_mark", None)
         where = f" at line {mark.line + 1}" if mark is not None else ""

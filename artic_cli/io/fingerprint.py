@@ -17,6 +17,7 @@ import ast
 import functools
 import hashlib
 import json
+import os
 from pathlib import Path
 from typing import Iterable
 
@@ -106,17 +107,13 @@ def _exists(name: str) -> bool:
     return name == PACKAGE or (name.startswith(PACKAGE + ".") and module_path(name).is_file())
 
 
-@functools.lru_cache(maxsize=None)
-def _parsed(name: str) -> ast.Module:
-    return ast.parse(module_path(name).read_text(), filename=str(module_path(name)))
-
-
-def _imports(name: str) -> set[str]:
-    """The artic_cli modules ``name`` imports, at any depth of its code (function-level imports too)."""
+def _imports_of(name: str, tree: ast.Module) -> frozenset[str]:
+    """The artic_cli modules ``name`` (parsed: ``tree``) imports, at any depth of its code (function-level
+    imports too)."""
     is_pkg = module_path(name).name == "__init__.py"
     package = name if is_pkg else name.rpartition(".")[0]
     out: set[str] = set()
-    for node in ast.walk(_parsed(name)):
+    for node in ast.walk(tree):
         if isinstance(node, ast.Import):
             out.update(a.name for a in node.names if _exists(a.name))
         elif isinstance(node, ast.ImportFrom):
@@ -130,7 +127,57 @@ def _imports(name: str) -> set[str]:
             for a in node.names:
                 sub = f"{base}.{a.name}"
                 out.add(sub if _exists(sub) else base)
-    return {m for m in out if _exists(m)}
+    return frozenset(m for m in out if _exists(m))
+
+
+# each module's imports and code hash, kept on disk by its file's size and modification time (parsing and
+# hashing 80 modules costs 2 s of every command's start otherwise); a damaged or unwritable cache is remade
+CODE_CACHE = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "artic" / (
+    "code-" + hashlib.sha256(str(PACKAGE_DIR).encode()).hexdigest()[:12] + ".json")
+_changed: list[bool] = [False]
+
+
+@functools.lru_cache(maxsize=None)
+def _code_cache() -> dict:
+    try:
+        data = json.loads(CODE_CACHE.read_text())
+        return data if isinstance(data, dict) else {}
+    except (OSError, ValueError):
+        return {}
+
+
+def _save_code_cache() -> None:
+    if not _changed[0]:
+        return
+    try:
+        CODE_CACHE.parent.mkdir(parents=True, exist_ok=True)
+        tmp = CODE_CACHE.with_suffix(f".{os.getpid()}.tmp")
+        tmp.write_text(json.dumps(_code_cache()))
+        tmp.replace(CODE_CACHE)
+        _changed[0] = False
+    except OSError:
+        pass
+
+
+@functools.lru_cache(maxsize=None)
+def _module_facts(name: str) -> tuple[str, frozenset[str]]:
+    """(code hash, imported artic_cli modules) of module ``name``: from the cache while its file is unchanged."""
+    path = module_path(name)
+    st = path.stat()
+    sig = [st.st_mtime_ns, st.st_size]
+    hit = _code_cache().get(str(path))
+    if isinstance(hit, dict) and hit.get("sig") == sig:
+        return hit["hash"], frozenset(hit["imports"])
+    tree = ast.parse(path.read_text(), filename=str(path))
+    imports = _imports_of(name, tree)
+    code = hashlib.sha256(ast.dump(_strip_docstrings(tree), annotate_fields=False).encode()).hexdigest()
+    _code_cache()[str(path)] = {"sig": sig, "hash": code, "imports": sorted(imports)}
+    _changed[0] = True
+    return code, imports
+
+
+def _imports(name: str) -> frozenset[str]:
+    return _module_facts(name)[1]
 
 
 def module_closure(*roots: str, within: str | None = None) -> list[str]:
@@ -169,13 +216,11 @@ def source_hash(text: str) -> str:
 
 
 @functools.lru_cache(maxsize=None)
-def _module_code_hash(name: str) -> str:
-    return source_hash(module_path(name).read_text())
-
-
 def code_hash(*roots: str) -> str:
     """Hash of the code of ``roots`` and of what they import (syntax trees without docstrings or comments)."""
-    return digest({m: _module_code_hash(m) for m in module_closure(*roots)})
+    out = digest({m: _module_facts(m)[0] for m in module_closure(*roots)})
+    _save_code_cache()
+    return out
 
 
 def source_files(*roots: str) -> list[Path]:

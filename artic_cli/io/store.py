@@ -275,10 +275,10 @@ def write_text_atomic(path: Path | str, text: str) -> Path:
 
 
 def _read_doc(path: Path):
-    import yaml
+    from ..validation import load_yaml
 
     text = Path(path).read_text()
-    return json.loads(text) if Path(path).suffix == ".json" else yaml.safe_load(text)
+    return json.loads(text) if Path(path).suffix == ".json" else load_yaml(text)
 
 
 def doc_content_hash(doc: dict) -> str:

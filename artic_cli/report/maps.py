@@ -59,10 +59,10 @@ def map_rows(data: Path) -> tuple[list[Row], list[str]]:
     lines = ["![EP vectors and contour nets (Fig. 8)](fig8_epmap.png)",
              "![A jaw position's map, simulated and derived (Fig. 9)](fig9_dynamic_map.png)", ""]
     sols = sorted((data / "solutions").glob("*.yaml")) if (data / "solutions").is_dir() else []
-    import yaml
+    from ..validation import load_yaml
 
     for path in sols:
-        doc = yaml.safe_load(path.read_text())
+        doc = load_yaml(path.read_text())
         if not isinstance(doc, dict):
             continue
         name = doc.get("target", path.stem)

@@ -3,10 +3,11 @@ on load (docs/inventory.md), and romaji split into its symbols."""
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Annotated, Literal
 
-from pydantic import Field, model_validator
+from pydantic import BeforeValidator, Field, model_validator
 
 from ..config import read_yaml
 from ..control.solver import JawSpec, Lips
@@ -22,6 +23,24 @@ Place = Literal["bilabial", "alveolar", "postalveolar", "palatal", "velar", "glo
 Height = Literal["high-front", "high-central", "high-back", "mid-front", "mid-central", "mid-back", "low-front",
                  "low-central", "low-back"]
 Area = Annotated[float, Field(gt=0, le=2, allow_inf_nan=False)]
+JAW_NAME = re.compile(r"^(rest|(JO|JC)_(\d+(\.\d+)?))$")
+
+
+def _jaw_position(v):
+    """A jaw named as the EP maps name their jaw positions (``rest``, ``JO_6``: the opener holding 6 N, ``JC_1.5``:
+    the closer 1.5 N), or ``{opening_cm: x}`` (the incisors x cm from rest)."""
+    if isinstance(v, str):
+        m = JAW_NAME.match(v.strip())
+        if m is None:
+            raise ValueError(f"jaw '{v}': give a jaw position (rest, JO_<N> or JC_<N>, e.g. JO_2.5) or "
+                             "{opening_cm: x}")
+        return {"forces_n": {} if m.group(1) == "rest" else {m.group(2): float(m.group(3))}}
+    if isinstance(v, dict) and "forces_n" in v:
+        raise ValueError("an inventory names jaw positions (rest, JO_<N>, JC_<N>) or {opening_cm: x}, not forces")
+    return v
+
+
+Jaw = Annotated[JawSpec, BeforeValidator(_jaw_position)]
 NEEDS_PLACE = ("stop", "nasal", "fricative", "affricate", "tap", "approximant")
 
 
@@ -33,7 +52,7 @@ class Phoneme(Strict):
     velum_port_cm2: Annotated[float, Field(ge=0, le=2, allow_inf_nan=False)] = 0.0
     glottis_cm2: Area | None = None  # else adducted (voiced) or speech.glottal_area_voiceless_cm2
     lips: Literal["closed", "rounded", "compressed", "spread", "neutral", "open"] | Lips = "neutral"
-    jaw: JawSpec | None = None
+    jaw: Jaw | None = None
     formants_hz: Annotated[list[FormantHz], Field(min_length=2, max_length=3)] | None = None
     tongue_highest: Height | None = None
     palatalized: bool = False
@@ -82,8 +101,8 @@ class Inventory(Strict):
     language: str
     sources: list[str] = []
     places: dict[Place, str]  # a phonetic place -> the tract's place (an area-law region, lips or glottis)
-    jaws: dict[Place, JawSpec] = {}  # a consonant's jaw position at its place, unless its entry gives one
-    vowel_jaw_beside: dict[Place, JawSpec] = {}  # a vowel next to a consonant of this place: at most this open
+    jaws: dict[Place, Jaw] = {}  # a consonant's jaw position at its place, unless its entry gives one
+    vowel_jaw_beside: dict[Place, Jaw] = {}  # a vowel next to a consonant of this place: at most this open
     realisation: Realisation = Realisation()
     phonemes: dict[str, Phoneme]
 

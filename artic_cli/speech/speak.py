@@ -116,6 +116,14 @@ def segment_vectors(u: Utterance, p: Plan, model: Model, max_force_n: float) -> 
                      for f, seg in zip(p.forces_n, u.segments)])
 
 
+def default_leads_ms(u: Utterance, cfg: Config) -> tuple[float, float]:
+    """The lead and the first segment's preparation (ms) a segment has unless it or its utterance gives one:
+    the config's, or 0 and 0 with the static course (the paper's controller: each target's forces switched on at
+    its segment's start and held)."""
+    how = cfg.speech.force_course if u.force_course is None else u.force_course
+    return (0.0, 0.0) if how == "static" else (cfg.speech.lead_ms, cfg.speech.prepare_ms)
+
+
 def force_course(u: Utterance, p: Plan, model: Model, cfg: Config) -> Course:
     """The plan's forces in time: every segment's forces switch on its lead before its sound (the utterance's
     or the config's, or its own); the first one's ``prep`` (>= its lead) before it, during a silent lead-in
@@ -124,9 +132,10 @@ def force_course(u: Utterance, p: Plan, model: Model, cfg: Config) -> Course:
     vectors = segment_vectors(u, p, model, cfg.muscles.max_force_n)
     ramp_s = units.ms_to_s(sp.ramp_ms if u.ramp_ms is None else u.ramp_ms)
     how = sp.force_course if u.force_course is None else u.force_course
-    lead = units.ms_to_s(sp.lead_ms if u.lead_ms is None else u.lead_ms)
-    leads = units.ms_to_s(np.array(u.leads_ms(sp.lead_ms)))
-    prep = max(leads[0], units.ms_to_s(sp.prepare_ms if u.prepare_ms is None else u.prepare_ms))
+    lead_ms, prepare_ms = default_leads_ms(u, cfg)
+    lead = units.ms_to_s(lead_ms if u.lead_ms is None else u.lead_ms)
+    leads = units.ms_to_s(np.array(u.leads_ms(lead_ms)))
+    prep = max(leads[0], units.ms_to_s(prepare_ms if u.prepare_ms is None else u.prepare_ms))
     duration = float(p.starts_s[-1] + p.durations_s[-1])
     starts = np.asarray(p.starts_s, float) - leads + prep
     starts[0] = 0.0
@@ -184,18 +193,18 @@ def course_trajectory(model: Model, c: Course, cfg: Config, rest, progress=None,
     return traj
 
 
-def move(model: Model, c: Course, cfg: Config, lap: Laps, progress=None, rest=None
+def move(model: Model, c: Course, cfg: Config, lap: Laps, progress=None, rest=None, simulated=None
          ) -> tuple[Trajectory, np.ndarray, float]:
-    """The course simulated from the rest posture (``rest``, settled here if not given): the trajectory (its
-    clock at the sound's start), where each segment's forces lead (cm) and how far any node got beyond the
-    wall (cm)."""
+    """The course simulated from the rest posture (``rest``, settled here if not given; ``simulated``: its
+    trajectory, if already simulated): the trajectory (its clock at the sound's start), where each segment's
+    forces lead (cm) and how far any node got beyond the wall (cm)."""
     sp = cfg.speech
     rest = settle(model) if rest is None else rest
     lap("rest posture")
     dt = units.ms_to_s(cfg.simulation.dt_ms)
     eps = equilibria(model, rest, c.vectors, units.ms_to_s(sp.reach_hold_ms), dt)
     lap("segment EPs")
-    traj = course_trajectory(model, c, cfg, rest, progress, lap)
+    traj = course_trajectory(model, c, cfg, rest, progress, lap) if simulated is None else simulated
     lap("simulation")
     beyond = 0.0
     if model.contact is not None:  # how far any contact node got beyond the wall (cm)
@@ -257,12 +266,13 @@ def sound(u: Utterance, p: Plan, tracts: Tracts, time_s: np.ndarray, duration_s:
     return out.audio, tb, glottis, air
 
 
-def speak_plan(u: Utterance, p: Plan, cfg: Config, model: Model, progress=None, rest=None) -> Spoken:
-    """Simulate the plan's force course on ``model`` from the rest posture (``rest``, if settled already) and
-    voice it."""
+def speak_plan(u: Utterance, p: Plan, cfg: Config, model: Model, progress=None, rest=None, simulated=None
+               ) -> Spoken:
+    """Simulate the plan's force course on ``model`` from the rest posture (``rest``, if settled already;
+    ``simulated``: the course's trajectory from it, if simulated already) and voice it."""
     c = force_course(u, p, model, cfg)
     lap = Laps()
-    traj, eps, beyond = move(model, c, cfg, lap, progress, rest)
+    traj, eps, beyond = move(model, c, cfg, lap, progress, rest, simulated)
     bad = problems(traj, model.volume_constraint)
     if bad:
         raise NotPhysical(f"utterance '{u.name}': the simulation is not physical ({'; '.join(bad)}); nothing written")

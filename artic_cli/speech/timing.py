@@ -23,7 +23,7 @@ from ..mechanics.model import Model
 from ..tract.places import place_area, place_index, section_places
 from ..tract.speaker import speaker_tract
 from .plan import Plan
-from .speak import course_trajectory, force_course, tracts_of_run
+from .speak import course_trajectory, default_leads_ms, force_course, tracts_of_run
 from .utterance import Utterance
 
 ROUNDS = 6
@@ -47,6 +47,7 @@ class Timing:
     rounds: int
     onset_late_ms: dict[int, float]  # per constriction segment: when its constriction was first made (NaN: never)
     released_early_ms: dict[int, float]  # ... how long before its end it opened again
+    trajectory: object = None  # the returned utterance's movement, when the last round simulated it as it is
 
 
 def goals_of(targets: list[TargetSpec | None], cfg: Config) -> list[Goal]:
@@ -61,12 +62,12 @@ def goals_of(targets: list[TargetSpec | None], cfg: Config) -> list[Goal]:
 
 
 def place_areas(u: Utterance, p: Plan, cfg: Config, model: Model, rest, goals: list[Goal]):
-    """(frame times s, {segment: its place's area per frame, cm^2}) of the utterance simulated."""
+    """(the utterance's movement, {segment: its place's area per frame, cm^2})."""
     c = force_course(u, p, model, cfg)
     traj = course_trajectory(model, c, cfg, rest)
     tracts = tracts_of_run(u, p, model, traj, cfg)
     region, _ = section_places(speaker_tract(cfg))
-    return traj.time, {g.segment: place_area(tracts.af.area_cm2, region, g.place) for g in goals}
+    return traj, {g.segment: place_area(tracts.af.area_cm2, region, g.place) for g in goals}
 
 
 def onset_and_release(t: np.ndarray, area: np.ndarray, reach: float, start: float, end: float):
@@ -94,7 +95,7 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
     if not goals:
         return u, None
     segs = u.segments
-    leads = np.array(u.leads_ms(cfg.speech.lead_ms), float)
+    leads = np.array(u.leads_ms(default_leads_ms(u, cfg)[0]), float)
     press = np.array([s.press for s in segs], float)
     free_lead = [s.lead_ms is None for s in segs]
     free_press = [s.press == 1.0 for s in segs]
@@ -106,7 +107,8 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
     late, early = {}, {}
     for r in range(rounds):
         trial = _with(u, leads, press)
-        t, areas = place_areas(trial, p, cfg, model, rest, goals)
+        traj, areas = place_areas(trial, p, cfg, model, rest, goals)
+        t = traj.time
         changed = False
         for g in goals:
             k = g.segment
@@ -125,7 +127,8 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
         if not changed:
             break
     return _with(u, leads, press), Timing(leads_ms=leads.tolist(), press=press.tolist(), rounds=r + 1,
-                                          onset_late_ms=late, released_early_ms=early)
+                                          onset_late_ms=late, released_early_ms=early,
+                                          trajectory=None if changed else traj)
 
 
 def _lead_more(leads: np.ndarray, starts: np.ndarray, k: int, by_ms: float, free: list[bool]) -> bool:

@@ -233,5 +233,5 @@ def speak(utterance: Path | str | Utterance, out: Path | str | None = None, maps
     if timing is not None and say:
         say(f"timing: {timing.rounds} round(s); leads {', '.join(f'{v:.0f}' for v in timing.leads_ms)} ms; "
             f"presses {', '.join(f'{v:.2f}' for v in timing.press)}")
-    s = speak_plan(u, p, view, model, progress, rest)
+    s = speak_plan(u, p, view, model, progress, rest, timing.trajectory if timing is not None else None)
     return SpeakResult(write(out, s, prov), s)

@@ -14,7 +14,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import yaml
 
 from ..config import Config, load_config
 from ..control.equilibrium import map_ep_state, parse_ep
@@ -29,6 +28,7 @@ from ..tract.controls import check_overrides, controls_for
 from ..tract.outline import Grid
 from ..tract.shapes import rest_shapes, shapes_of_model, shapes_of_simulation
 from ..tract.speaker import TRACT_SECTIONS, speaker_tract
+from ..validation import load_yaml
 from . import mesh as mesh_stage
 from . import paths
 from . import simulate as simulate_stage
@@ -154,7 +154,7 @@ def vocal_tract(sim: Path | str | None = None, rest: bool = False, ep: str | Non
         s = simulate_stage.read(sim)
         _check_simulation(s, sim, m.content_sha256, cfg)
         text = str(s.attrs.get("schedule_yaml", "") or "")
-        sched: Schedule = parse_schedule(yaml.safe_load(text) if text else {}, f"{sim} (its schedule)",
+        sched: Schedule = parse_schedule(load_yaml(text) if text else {}, f"{sim} (its schedule)",
                                          cfg.muscles.max_force_n)
         entries = sched.tract
         out = Path(out) if out is not None else paths.TRACTS / f"{Path(sim).stem}.h5"

@@ -20,7 +20,8 @@ def test_the_inventory_names_every_symbol_with_features_and_places_the_tract_has
     assert not any(p[s].voiced for s in ("p", "t", "k", "s", "sh", "h", "f", "ts", "ch"))
     assert all(p[s].manner == "stop" for s in ("p", "b", "t", "d", "k", "g"))
     assert p["r"].manner == "tap" and p["r"].duration_ms <= 30
-    # features, never muscle forces: the only forces are a vowel's jaw position (JO / JC)
+    # features, never muscle forces: a jaw is a mapped jaw position, read as the opener's or closer's force
+    assert p["a"].jaw.forces_n == {"JO": 6.0} and p["u"].jaw.forces_n == {}
     assert {k for e in p.values() if e.jaw is not None for k in (e.jaw.forces_n or {})} <= {"JO", "JC"}
 
 
@@ -35,6 +36,9 @@ def test_the_inventory_names_every_symbol_with_features_and_places_the_tract_has
     (lambda d: d["phonemes"]["k"].update(duration_ms=float("nan")), "phonemes.k.duration_ms"),
     (lambda d: d["phonemes"]["k"].update(forces_n={"SG": 2}), "phonemes.k.forces_n"),
     (lambda d: d["places"].pop("velar"), "'velar' has no entry under 'places'"),
+    (lambda d: d["phonemes"]["a"].update(jaw="JO_six"), "phonemes.a.jaw"),
+    (lambda d: d["phonemes"]["a"].update(jaw={"forces_n": {"JO": 6}}), "names jaw positions"),
+    (lambda d: d["jaws"].update(velar="JX_1"), "jaws.velar"),
 ])
 def test_a_bad_inventory_is_one_error_naming_the_key(tmp_path, change, says):
     d = yaml.safe_load(DEFAULT.read_text())

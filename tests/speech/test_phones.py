@@ -118,3 +118,26 @@ def _plan(u) -> Plan:
                 durations_s=np.array([s.duration_ms for s in u.segments]) / 1e3, forces_n=[{}] * n,
                 lips=[LIPS] * n, ports=[0.0] * n, voiced=np.ones(n, bool), glottis_cm2=np.zeros(n), notes=[""] * n,
                 solutions=[""] * n, continues=[s.continues for s in u.segments])
+
+
+def _keys(node):
+    if isinstance(node, dict):
+        for k, v in node.items():
+            yield k
+            yield from _keys(v)
+    elif isinstance(node, list):
+        for v in node:
+            yield from _keys(v)
+
+
+def test_no_utterance_or_phoneme_entry_in_configs_types_forces_a_press_or_a_lead():
+    from pathlib import Path
+
+    import yaml
+
+    root = Path(__file__).resolve().parents[2] / "configs"
+    files = sorted((root / "utterances").glob("*.yaml")) + sorted((root / "phonemes").glob("*.yaml"))
+    assert len(files) >= 43  # 42 utterances and the inventory
+    typed = {f.name: sorted(set(_keys(yaml.safe_load(f.read_text()))) & {"forces_n", "press", "lead_ms"})
+             for f in files}
+    assert {k: v for k, v in typed.items() if v} == {}
