@@ -26,7 +26,7 @@ The mechanics ignore ``tract``: a change there leaves every simulation up to dat
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Literal
 
 import numpy as np
 from pydantic import Field, ValidationInfo, field_validator
@@ -62,17 +62,21 @@ class MuscleEntry(Strict):
 
 
 class TractEntry(Strict):
-    """From ``at_ms`` the given tract controls move to their new values over ``ramp_ms`` (raised cosine)."""
+    """From ``at_ms`` the given tract controls move to their new values over ``ramp_ms`` (a raised cosine, or
+    at a constant rate: ``ramp: linear``)."""
 
     at_ms: OnsetMs
     ramp_ms: NonNegative = 50.0
+    ramp: Literal["cosine", "linear"] = "cosine"
     lip_area_cm2: AreaCm2 | None = None
     lip_length_cm: Annotated[float, Field(gt=0, le=3, allow_inf_nan=False)] | None = None
     velum_port_cm2: AreaCm2 | None = None
     glottis_cm2: Annotated[float, Field(ge=0, le=2, allow_inf_nan=False)] | None = None  # its mean opening
+    # the cavity's active enlargement (a lowered larynx, an advanced tongue root) beyond its shape's volume
+    cavity_expansion_cm3: Annotated[float, Field(ge=0, le=30, allow_inf_nan=False)] | None = None
 
 
-TRACT_CONTROLS = ("lip_area_cm2", "lip_length_cm", "velum_port_cm2", "glottis_cm2")
+TRACT_CONTROLS = ("lip_area_cm2", "lip_length_cm", "velum_port_cm2", "glottis_cm2", "cavity_expansion_cm3")
 
 
 def tract_controls(entries: list[TractEntry], start: dict[str, float], time_s) -> dict[str, np.ndarray]:
@@ -81,6 +85,8 @@ def tract_controls(entries: list[TractEntry], start: dict[str, float], time_s) -
     t_ms = np.asarray(time_s, dtype=float) * 1e3
     out = {}
     for name in TRACT_CONTROLS:
+        if name not in start:  # a control the caller does not drive
+            continue
         value = np.full_like(t_ms, float(start[name]))
         for e in sorted(entries, key=lambda e: e.at_ms):
             target = getattr(e, name)
@@ -89,7 +95,7 @@ def tract_controls(entries: list[TractEntry], start: dict[str, float], time_s) -
             before = float(np.interp(e.at_ms, t_ms, value)) if len(t_ms) else float(start[name])
             if e.ramp_ms > 0:
                 u = np.clip((t_ms - e.at_ms) / e.ramp_ms, 0.0, 1.0)
-                w = 0.5 - 0.5 * np.cos(np.pi * u)
+                w = u if e.ramp == "linear" else 0.5 - 0.5 * np.cos(np.pi * u)
             else:
                 w = (t_ms >= e.at_ms).astype(float)
             value = np.where(t_ms >= e.at_ms, before + (target - before) * w, value)

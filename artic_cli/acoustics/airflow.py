@@ -9,7 +9,10 @@ the constriction) of the same mass, resistance and stiffness per unit area as th
 (m x'' + r x' + k x = P), taking S x' of the flow (Rothenberg 1968, Westbury 1983: the walls' expansion is
 what lets voicing go on behind a closure; Stevens 1998, ch. 2.1-2.2, for the model):
 
-    V / (rho c^2) dP/dt = U_g - U_c - U_n - S x'.
+    V / (rho c^2) dP/dt = U_g - U_c - U_n - S x' - dV_a/dt,
+
+V_a the cavity's active enlargement (a voiced obstruent's lowered larynx and advanced tongue root:
+Kent & Moll 1969, Westbury 1983), a control input.
 
 Each step is backward Euler for P (Newton inside a bisection bracket: the right side falls as P rises, so one root) with the
 wall's velocity solved with it; the step is a few of the line's samples (the cavity's time constant at a
@@ -113,8 +116,8 @@ def _slope(area, dp, rho):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _cavity_pressure(lung, glottis, constriction, nose, compliance, wall_area, wall_m, wall_r, wall_k, rho,
-                     dt):  # pragma: no cover - compiled
+def _cavity_pressure(lung, glottis, constriction, nose, compliance, wall_area, expansion, wall_m, wall_r, wall_k,
+                     rho, dt):  # pragma: no cover - compiled
     """(P, U_g, U_c, U_n) per step: P the cavity's pressure (dyn/cm^2), the flows cm^3/s."""
     n = glottis.shape[0]
     p_out, ug, uc, un = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
@@ -128,7 +131,7 @@ def _cavity_pressure(lung, glottis, constriction, nose, compliance, wall_area, w
         x_ = p  # Newton from the last step's pressure, kept inside a bisection bracket (the residual rises with P)
         for _ in range(60):
             r = c_dt * (x_ - p) - (_orifice(glottis[s], lung - x_, rho) - _orifice(constriction[s], x_, rho)
-                                   - _orifice(nose[s], x_, rho) - wall_area[s] * (a + x_ / d))
+                                   - _orifice(nose[s], x_, rho) - wall_area[s] * (a + x_ / d) - expansion[s])
             if r < 0.0:
                 lo = x_
             else:
@@ -166,16 +169,18 @@ class Airflow:
 
 
 def airflow(time_s: np.ndarray, lung_pressure: float, glottis_cm2: np.ndarray, constriction_cm2: np.ndarray,
-            nose_cm2: np.ndarray, volume_cm3: np.ndarray, wall_cm2: np.ndarray, ac) -> Airflow:
+            nose_cm2: np.ndarray, volume_cm3: np.ndarray, wall_cm2: np.ndarray, ac,
+            expansion_cm3_s: np.ndarray | float = 0.0) -> Airflow:
     """The cavity's pressure and the flows at each of ``time_s`` (evenly spaced), the inputs given there
-    (``ac``: the config's acoustics section: air and walls)."""
+    (``ac``: the config's acoustics section: air and walls; ``expansion_cm3_s``: the cavity's active
+    enlargement, the rate its volume grows by the speaker's own doing)."""
     t = np.asarray(time_s, float)
     dt = float(t[1] - t[0]) if len(t) > 1 else 1e-4
     rho, c = ac.air_density_g_cm3, ac.sound_speed_cm_s
     compliance = np.maximum(np.asarray(volume_cm3, float), 1e-3) / (rho * c * c)
     walls = np.asarray(wall_cm2, float) if ac.yielding_walls else np.zeros(len(t))
     arrays = [np.ascontiguousarray(np.broadcast_to(np.asarray(v, float), t.shape)) for v in
-              (glottis_cm2, constriction_cm2, nose_cm2, compliance, walls)]
+              (glottis_cm2, constriction_cm2, nose_cm2, compliance, walls, expansion_cm3_s)]
     so = ac.sources
     p, ug, uc, un = _cavity_pressure(float(lung_pressure), *arrays, ac.wall_mass_g_cm2,
                                      so.cavity_wall_resistance_dyn_s_cm3, ac.wall_stiffness_dyn_cm3, rho, dt)

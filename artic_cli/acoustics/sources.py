@@ -33,6 +33,7 @@ class Larynx:
     voicing: np.ndarray
     noise: object
     voiced_cm2: float
+    expansion_cm3: np.ndarray | None = None  # the cavity's active enlargement (cm^3), none if not given
 
 
 @dataclass
@@ -79,8 +80,11 @@ def _air(areas: np.ndarray, index: np.ndarray, step_s: float, section_cm: float,
     port = np.interp(index, frames, larynx.port_cm2)
     nose = _nose_cm2(port, ac, cav.at_cm <= larynx.port_at_cm)
     if ac.sources.bursts:
+        grow = 0.0
+        if larynx.expansion_cm3 is not None and len(index) > 1:
+            grow = np.gradient(np.interp(index, frames, larynx.expansion_cm3), step_s)
         a = airflow(step_s * np.arange(len(index)), larynx.lung_pressure, glottis, cav.area_cm2, nose,
-                    cav.volume_cm3, cav.wall_cm2, ac)
+                    cav.volume_cm3, cav.wall_cm2, ac, grow)
         return _Air(a.oral_pressure, a.glottal_flow, a.constriction_flow, a.nasal_flow, glottis, cav, nose)
     u = flow(larynx.lung_pressure, glottis, cav.area_cm2, ac.air_density_g_cm3)
     drop = 0.5 * ac.air_density_g_cm3 * (u / np.maximum(cav.area_cm2, 1e-6)) ** 2

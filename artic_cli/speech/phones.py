@@ -161,10 +161,12 @@ def realise(u: Utterance, inv: Inventory, default_lips: tuple[float, float]) -> 
         lips = _lips(p) if p.lips != "neutral" else (_lips(nv) if nv is not None else None)
         voiced = p.voiced if sym != "N" else True
         glottis = p.glottis_cm2
+        closing = voiced and p.manner in ("stop", "affricate") and p.velum_port_cm2 == 0 and sym not in ("N", "Q")
+        expand = inv.realisation.voiced_stop_expansion_cm3_s if closing else None
         beside = [_neighbour(symbols, k, d, inv) for d in (-1, 1)] if p.manner == "vowel" else []
         for n, (target, share) in enumerate(_parts(sym, p, inv, lips, beside)):
             common = dict(duration_ms=seg.duration_ms * share, voiced=voiced, glottis_cm2=glottis,
-                          label=sym if n == 0 else None, continues=n > 0)
+                          label=sym if n == 0 else None, continues=n > 0, cavity_expansion_cm3_s=expand)
             segments.append(Segment(target=target, **common) if target is not None else Segment(hold=True, **common))
         if p.lips == "closed" or (p.place == "bilabial" and p.manner == "fricative"):
             area = 0.0 if p.lips == "closed" else p.channel_cm2
@@ -179,6 +181,7 @@ def realise(u: Utterance, inv: Inventory, default_lips: tuple[float, float]) -> 
                                         lip_area_cm2=tube[0], lip_length_cm=tube[1]))
         if p.velum_port_cm2 > 0:
             nasal_runs.append((t, t + seg.duration_ms, p.velum_port_cm2))
+
         t += seg.duration_ms
     tract += _port_entries(nasal_runs, inv.realisation.nasal_margin_ms, u.duration_ms)
     return u.model_copy(update={"segments": segments, "tract": tract})

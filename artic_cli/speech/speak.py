@@ -33,6 +33,7 @@ from ..tract.controls import controls_for
 from ..tract.shapes import shapes_of_model
 from ..tract.speaker import speaker_tract
 from .course import activated, course, pulse_step
+from .expansion import expansion_entries
 from .plan import Plan
 from .utterance import Utterance
 
@@ -227,7 +228,11 @@ def tracts_of_run(u: Utterance, p: Plan, model: Model, traj: Trajectory, cfg: Co
     voicing_ramp = cfg.speech.voicing_ramp_ms
     entries += [TractEntry(at_ms=float(s * 1e3), ramp_ms=voicing_ramp if k else 0.0, glottis_cm2=float(g))
                 for k, (s, g) in enumerate(zip(p.starts_s, p.glottis_cm2))]
-    return tracts_of(vt, cfg.speaker.wall, shapes, controls_for(vt, traj.time, entries + list(u.tract)))
+    tracts = tracts_of(vt, cfg.speaker.wall, shapes, controls_for(vt, traj.time, entries + list(u.tract)))
+    grow = expansion_entries(u.segments, p.starts_s, traj.time, tracts.af.area_cm2.min(axis=1))
+    if grow:  # the cavity's enlargement moves no wall of the area function
+        tracts.controls = controls_for(vt, traj.time, entries + list(u.tract) + grow)
+    return tracts
 
 
 def formant_tracks(tracts: Tracts, time_s: np.ndarray, cfg: Config) -> np.ndarray:
@@ -256,7 +261,7 @@ def sound(u: Utterance, p: Plan, tracts: Tracts, time_s: np.ndarray, duration_s:
     larynx = Larynx(glottis_cm2=glottis, port_cm2=tracts.controls["velum_port_cm2"],
                     port_at_cm=float(np.mean(port_positions(tracts))),
                     lung_pressure=units.kpa_to_cgs(sp.lung_pressure_kpa), voicing=voicing, noise=sp.noise,
-                    voiced_cm2=cfg.vocal_tract.glottis_cm2)
+                    voiced_cm2=cfg.vocal_tract.glottis_cm2, expansion_cm3=tracts.controls.get("cavity_expansion_cm3"))
     out = synthesize_speech(tracts.af.length_cm, tracts.af.area_cm2, time_s, aco, duration_s, larynx,
                             contour=[(float(a), float(b)) for a, b in u.f0_hz] if len(u.f0_hz) > 1 else None,
                             f0_hz=float(u.f0_hz[0][1]), flow_peak_cm3_s=sp.glottal_flow_peak_cm3_s)

@@ -1,5 +1,5 @@
-"""The tract's control inputs frame by frame: the lip tube (area, length), the velopharyngeal port and the
-glottis's mean opening."""
+"""The tract's control inputs frame by frame: the lip tube (area, length), the velopharyngeal port, the
+glottis's mean opening and the cavity's active enlargement."""
 
 from __future__ import annotations
 
@@ -11,9 +11,9 @@ from ..validation import check_number
 
 
 def default_controls(vt: VocalTract) -> dict[str, float]:
-    """The config's lip tube, port and glottis (cm^2, cm)."""
+    """The config's lip tube, port and glottis (cm^2, cm), the cavity not enlarged (cm^3)."""
     return {"lip_area_cm2": vt.lips.area_cm2, "lip_length_cm": vt.lips.length_cm, "velum_port_cm2": vt.velum_port_cm2,
-            "glottis_cm2": vt.glottis_cm2}
+            "glottis_cm2": vt.glottis_cm2, "cavity_expansion_cm3": 0.0}
 
 
 def controls_for(vt: VocalTract, time_s: np.ndarray, entries: list[TractEntry] | None = None,
