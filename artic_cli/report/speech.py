@@ -103,8 +103,38 @@ def utterance_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row
                          f"(tip / dorsum / jaw, ms): {t90}; commanded force impulse {m['force_impulse_n_s']:.2f} "
                          f"N s, peak total {m['peak_total_force_n']:.1f} N")
     table, summary = landmark_table(records)
-    rows += summary
-    return rows, lines + [""] + table + [""] + pictures + [""]
+    made, made_rows = articulator_table(records)
+    rows += summary + made_rows
+    return rows, lines + [""] + table + [""] + made + [""] + pictures + [""]
+
+
+def articulator_table(records) -> tuple[list[str], list[Row]]:
+    """Each /t d n s z r k g/ between vowels: the dorsum's distance from where the vowels hold it and the
+    tip's rise at its narrowest frame (speech/articulation.py), and whether the articulator its entry names
+    made it; one row for how many did."""
+    from ..speech.articulation import LIMIT_CM, articulators
+    from ..speech.inventory import load_inventory
+    from ..speech.textgrid import read_phones
+
+    manners = {k: p.manner for k, p in load_inventory().phonemes.items()}
+    out = [f"Which articulator made each consonant (at its narrowest frame, against the vowels beside it; the tip's "
+           f"consonants keep the dorsum within {LIMIT_CM} cm, the dorsum's keep the tip from rising more):", ""]
+    done = total = 0
+    for path, rec in records:
+        tg = path.with_suffix(".TextGrid")
+        if not tg.is_file():
+            continue
+        for m in articulators(rec, read_phones(tg), manners):
+            done, total = done + m["ok"], total + 1
+            out.append(f"* /{rec.attrs.get('name', path.stem)}/ {m['symbol']} (the {m['by']}'s) at {m['at_s']:.3f} s: "
+                       f"dorsum {m['dorsum_cm']:.2f} cm from the vowels', tip {m['tip_rise_cm']:+.2f} cm; "
+                       + ("made so" if m["ok"] else "not made so"))
+    if not total:
+        return [], []
+    row = Row("Articulators (issue 45: the tip's consonants keep the dorsum, the dorsum's the tip)",
+              f"each within {LIMIT_CM} cm of the vowels' (goal)", f"{done} of {total}",
+              verdict(done == total, "every consonant made by its articulator"))
+    return out, [row]
 
 
 LANDMARK_COLUMNS = ("closure_ms", "closure_db", "closure_voiced", "voiced_share", "level_db", "low_ratio_db",

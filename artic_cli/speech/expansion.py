@@ -3,7 +3,7 @@
 Speakers keep voicing through a voiced stop's or fricative's constriction by enlarging the cavity behind it,
 lowering the larynx and advancing the tongue root (Kent & Moll 1969; Westbury 1983): without it the cavity
 fills, the transglottal pressure falls below the phonation threshold and the voice dies within a few tens of
-ms.  A segment asks for it with ``cavity_expansion_cm3_s`` (the inventory gives voiced stops and affricates
+ms.  A segment asks for it with ``cavity_expansion_cm3_s`` (the inventory gives voiced stops, affricates and taps
 ``realisation.voiced_stop_expansion_cm3_s``; a fricative's channel vents the cavity, its voice needs none);
 the enlargement runs over the stretch of frames where the tract is closed around the segment's interval (the
 articulators' own timing, not the interval's), and the volume is given back after the release.

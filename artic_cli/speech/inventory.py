@@ -94,9 +94,9 @@ class Realisation(Strict):
     nasal_margin_ms: Ms = 30.0  # the port opens this long before a nasal and closes as long after it
     lip_closing_ms: Ms = 20.0  # a bilabial's lips close over this, shut at its start
     lip_opening_ms: Ms = 15.0  # ... and open over this from its end
-    # a voiced stop or affricate enlarges the cavity behind its closure at this mean rate while the closure
-    # lasts (a lowered larynx, an advanced tongue root: docs/inventory.md, "Voicing in closures")
-    voiced_stop_expansion_cm3_s: Annotated[float, Field(ge=0, le=500, allow_inf_nan=False)] = 80.0
+    # a voiced stop, affricate or tap enlarges the cavity behind its closure at this mean rate while the closure
+    # lasts (a lowered larynx, an advanced tongue root: docs/modelling.md, "Sources")
+    voiced_stop_expansion_cm3_s: Annotated[float, Field(ge=0, le=500, allow_inf_nan=False)] = 120.0
 
 
 class Inventory(Strict):

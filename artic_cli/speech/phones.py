@@ -161,7 +161,7 @@ def realise(u: Utterance, inv: Inventory, default_lips: tuple[float, float]) -> 
         lips = _lips(p) if p.lips != "neutral" else (_lips(nv) if nv is not None else None)
         voiced = p.voiced if sym != "N" else True
         glottis = p.glottis_cm2
-        closing = voiced and p.manner in ("stop", "affricate") and p.velum_port_cm2 == 0 and sym not in ("N", "Q")
+        closing = voiced and p.manner in ("stop", "affricate", "tap") and p.velum_port_cm2 == 0 and sym not in ("N", "Q")
         expand = inv.realisation.voiced_stop_expansion_cm3_s if closing else None
         beside = [_neighbour(symbols, k, d, inv) for d in (-1, 1)] if p.manner == "vowel" else []
         for n, (target, share) in enumerate(_parts(sym, p, inv, lips, beside)):
