@@ -2,9 +2,9 @@
 beside it hold them (issue 45: the tip makes /t d n s z r/ with the dorsum within 0.6 cm of the vowels'; the
 dorsum makes /k g/ with the tip low).
 
-The consonant's frame is the middle one of its narrowest tract (its closure) in its interval (30 ms either side, as the
-articulators lead and lag it); the vowels' reference is the mean of their midpoints' positions (x, y in the
-midsagittal plane, cm).  "Low" for the tip reads the dorsum's limit: it rises at most 0.6 cm above the
+The consonant's frame is the middle one of its narrowest tract (its closure) in its interval (30 ms either
+side, as the articulators lead and lag it); the vowels' reference is the mean of their midpoints' positions
+(x, y in the midsagittal plane, cm).  "Low" for the tip reads the dorsum's limit: it rises at most 0.6 cm above the
 vowels' tip.
 """
 
@@ -47,5 +47,5 @@ def articulators(rec, intervals: list[tuple[float, float, str]], manners: dict[s
         by = "tip" if lab in TIP_MADE else "dorsum"
         ok = dorsum <= LIMIT_CM if by == "tip" else tip_rise <= LIMIT_CM
         out.append({"symbol": lab, "at_s": at, "dorsum_cm": dorsum, "tip_rise_cm": tip_rise, "by": by,
-                    "narrowest_cm2": float(narrowest[inside].min()), "ok": bool(ok)})
+                    "ok": bool(ok)})
     return out

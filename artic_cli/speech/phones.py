@@ -181,7 +181,6 @@ def realise(u: Utterance, inv: Inventory, default_lips: tuple[float, float]) -> 
                                         lip_area_cm2=tube[0], lip_length_cm=tube[1]))
         if p.velum_port_cm2 > 0:
             nasal_runs.append((t, t + seg.duration_ms, p.velum_port_cm2))
-
         t += seg.duration_ms
     tract += _port_entries(nasal_runs, inv.realisation.nasal_margin_ms, u.duration_ms)
     return u.model_copy(update={"segments": segments, "tract": tract})

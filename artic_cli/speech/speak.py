@@ -27,7 +27,7 @@ from ..geometry.anatomy import TONGUE_MUSCLES
 from ..mechanics.loads import muscle_force_vector, muscle_shares
 from ..mechanics.model import Control, Model
 from ..mechanics.simulate import Trajectory, problems, run, settle
-from ..schedule import TractEntry
+from ..schedule import TractEntry, tract_controls
 from ..tract.areas import Tracts, port_positions, tracts_of
 from ..tract.controls import controls_for
 from ..tract.shapes import shapes_of_model
@@ -230,8 +230,9 @@ def tracts_of_run(u: Utterance, p: Plan, model: Model, traj: Trajectory, cfg: Co
                 for k, (s, g) in enumerate(zip(p.starts_s, p.glottis_cm2))]
     tracts = tracts_of(vt, cfg.speaker.wall, shapes, controls_for(vt, traj.time, entries + list(u.tract)))
     grow = expansion_entries(u.segments, p.starts_s, traj.time, tracts.af.area_cm2.min(axis=1))
-    if grow:  # the cavity's enlargement moves no wall of the area function
-        tracts.controls = controls_for(vt, traj.time, entries + list(u.tract) + grow)
+    if grow:  # the cavity's enlargement moves no wall of the area function: only its own course is redrawn
+        tracts.controls["cavity_expansion_cm3"] = tract_controls(list(u.tract) + grow, {"cavity_expansion_cm3": 0.0},
+                                                                 traj.time)["cavity_expansion_cm3"]
     return tracts
 
 

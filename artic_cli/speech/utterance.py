@@ -50,7 +50,7 @@ class Segment(Strict):
     duration_ms: DurationMs
     voiced: bool = True  # the glottis adducted (vocal_tract.glottis_cm2) or abducted (speech.glottal_area_voiceless_cm2)
     glottis_cm2: Annotated[float, Field(ge=0, le=2, allow_inf_nan=False)] | None = None  # ... or this opening
-    # the cavity enlarging at this mean rate while the constriction the segment makes lasts (a voiced obstruent)
+    # the cavity enlarging at this rate while the closure the segment makes lasts (a voiced stop or tap)
     cavity_expansion_cm3_s: Annotated[float, Field(ge=0, le=500, allow_inf_nan=False)] | None = None
     label: SafeName | None = None  # the TextGrid's label (default: the target's name)
     lead_ms: Annotated[float, Field(ge=0, le=300, allow_inf_nan=False)] | None = None  # else the utterance's
