@@ -3,12 +3,19 @@ and press hard enough, that the model makes the constriction inside its interval
 switches on late enough that it holds to the interval's end (docs/inventory.md, "Timing").
 
 The utterance is simulated (mechanics and area function only, no sound), the area at each constriction's
-place read frame by frame, and the leads and presses moved by what was measured: a constriction reached
-``late`` ms after its start leads by that much more; one never reached presses harder (its tongue forces x
-``PRESS_STEP``, at most ``PRESS_MAX``) and leads ``LEAD_STEP_MS`` more; one released before its end (or, never
-made, narrowest before its end) delays the next segment's switch by as much.  Leads keep the switches in order (``MIN_GAP_MS`` apart); a segment whose
-lead or press the utterance gives is left as given.  A few rounds settle it; what each round measured is
-returned for the record.
+place read frame by frame, and the leads and presses moved by what was measured:
+
+* a constriction reached ``late`` ms after its start leads by that much more;
+* one never reached presses harder (its tongue forces x ``PRESS_STEP``, at most ``PRESS_MAX``), leads
+  ``LEAD_STEP_MS`` more and holds its own next part's switch (an affricate's release) back as much;
+* a channel never open to its area (an affricate's release after its closure) leads more and presses softer;
+* one released before its end (or, never made, narrowest before its end) delays the next segment's switch by
+  as much.
+
+Leads keep the switches in order (``MIN_GAP_MS`` apart); a segment whose lead or press the utterance gives is
+left as given.  The rounds stop when nothing moves or every constriction is on time; the round that missed
+the fewest ms of its constrictions' intervals is the one kept (the corrections of a closure and of the channel
+after it can swing), with what it measured.
 """
 
 from __future__ import annotations
@@ -26,7 +33,7 @@ from .plan import Plan
 from .speak import course_trajectory, default_leads_ms, force_course, tracts_of_run
 from .utterance import Utterance
 
-ROUNDS = 6
+ROUNDS = 9
 SLACK_MS = 3.0  # reached within this of the start, held to within this of the end: on time
 PRESS_STEP, PRESS_MAX = 1.15, 2.0
 LEAD_STEP_MS, LEAD_MAX_MS, MIN_GAP_MS = 20.0, 250.0, 10.0
@@ -37,7 +44,8 @@ WINDOW_MS = 20.0  # a constriction made this long before its interval counts as 
 class Goal:
     segment: int
     place: int  # index of the tract's place
-    reach_cm2: float  # reached at or below this area
+    reach_cm2: float  # reached at or below this area ...
+    floor_cm2: float = 0.0  # ... and above this one (a channel, not a closure)
 
 
 @dataclass
@@ -57,7 +65,8 @@ def goals_of(targets: list[TargetSpec | None], cfg: Config) -> list[Goal]:
     for k, t in enumerate(targets):
         if t is not None and t.constriction is not None and t.constriction.place in names:
             c = t.constriction
-            out.append(Goal(k, place_index(names, c.place), float(c.area_cm2 + c.tolerance_cm2)))
+            floor = c.area_cm2 - c.tolerance_cm2 if c.area_cm2 > c.tolerance_cm2 else 0.0
+            out.append(Goal(k, place_index(names, c.place), float(c.area_cm2 + c.tolerance_cm2), float(floor)))
     return out
 
 
@@ -70,10 +79,11 @@ def place_areas(u: Utterance, p: Plan, cfg: Config, model: Model, rest, goals: l
     return traj, {g.segment: place_area(tracts.af.area_cm2, region, g.place) for g in goals}
 
 
-def onset_and_release(t: np.ndarray, area: np.ndarray, reach: float, start: float, end: float):
-    """(ms after ``start`` the constriction is first made, NaN if never before ``end``; ms before ``end`` it opens
-    again, 0 if it holds; when never made, ms before ``end`` the area was narrowest: where it turned back)."""
-    ok = area <= reach
+def onset_and_release(t: np.ndarray, area: np.ndarray, reach: float, start: float, end: float, floor: float = 0.0):
+    """(ms after ``start`` the constriction is first made (its area at most ``reach``, above ``floor`` when that
+    is not 0), NaN if never before ``end``; ms before ``end`` it leaves that range again, 0 if it holds; when never
+    made, ms before ``end`` the area was narrowest: where it turned back)."""
+    ok = (area <= reach) & ((area > floor) if floor > 0 else True)
     window = (t >= start - WINDOW_MS / 1e3) & (t < end)
     hit = np.flatnonzero(ok & window)
     if not len(hit):
@@ -98,37 +108,75 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
     leads = np.array(u.leads_ms(default_leads_ms(u, cfg)[0]), float)
     press = np.array([s.press for s in segs], float)
     free_lead = [s.lead_ms is None for s in segs]
-    free_press = [s.press == 1.0 for s in segs]
+    free_press = [s.press == 1.0 for s in segs]  # (a press below 1 softens a channel's forces)
     starts = np.array(u.starts_ms(), float)
     ends = starts + np.array([s.duration_ms for s in segs])
     for k in range(1, len(segs)):  # a short part (an affricate's release, a glide) leads no more than fits
         if free_lead[k]:
             leads[k] = max(min(leads[k], starts[k] - (starts[k - 1] - leads[k - 1]) - MIN_GAP_MS), 0.0)
-    late, early = {}, {}
+    best = None
     for r in range(rounds):
         trial = _with(u, leads, press)
         traj, areas = place_areas(trial, p, cfg, model, rest, goals)
         t = traj.time
+        late, early = {}, {}
+        tried = leads.copy(), press.copy()
         changed = False
         for g in goals:
             k = g.segment
-            on, off = onset_and_release(t, areas[g.segment], g.reach_cm2, starts[k] / 1e3, ends[k] / 1e3)
+            on, off = onset_and_release(t, areas[g.segment], g.reach_cm2, starts[k] / 1e3, ends[k] / 1e3, g.floor_cm2)
             late[k], early[k] = on, off
             if not np.isfinite(on):
+                inside = areas[g.segment][(t >= starts[k] / 1e3) & (t < ends[k] / 1e3)]
+                if len(inside) and inside.max() <= g.floor_cm2:  # a channel too narrow: earlier and softer
+                    if free_press[k] and press[k] > 1.0 / PRESS_MAX:
+                        press[k] = max(press[k] / PRESS_STEP, 1.0 / PRESS_MAX)
+                        changed = True
+                    changed |= _lead_more(leads, starts, k, LEAD_STEP_MS, free_lead)
+                    continue
                 if free_press[k] and press[k] < PRESS_MAX:
                     press[k] = min(press[k] * PRESS_STEP, PRESS_MAX)
                     changed = True
                 changed |= _lead_more(leads, starts, k, LEAD_STEP_MS, free_lead)
+                if k + 1 < len(segs) and segs[k + 1].continues and free_lead[k + 1] and leads[k + 1] > 0:
+                    # nor let its own next part (an affricate's release) cut it short
+                    leads[k + 1] = max(leads[k + 1] - LEAD_STEP_MS, 0.0)
+                    changed = True
             elif on > SLACK_MS:
                 changed |= _lead_more(leads, starts, k, on, free_lead)
             if off > SLACK_MS and k + 1 < len(segs) and free_lead[k + 1] and leads[k + 1] > 0:
                 leads[k + 1] = max(leads[k + 1] - off, 0.0)
                 changed = True
-        if not changed:
+        score = missed_ms(goals, late, early, starts, ends, areas, t)
+        if best is None or score < best[0]:
+            best = (score, r, tried, late, early, traj)
+        if not changed or score == 0.0:
             break
+    score, at, (leads, press), late, early, traj = best
     return _with(u, leads, press), Timing(leads_ms=leads.tolist(), press=press.tolist(), rounds=r + 1,
-                                          onset_late_ms=late, released_early_ms=early,
-                                          trajectory=None if changed else traj)
+                                          onset_late_ms=late, released_early_ms=early, trajectory=traj)
+
+
+def missed_ms(goals: list[Goal], late: dict, early: dict, starts: np.ndarray, ends: np.ndarray,
+              areas: dict | None = None, t: np.ndarray | None = None) -> float:
+    """How much of the constrictions' intervals a round missed (ms): each made one's lateness and early release; a
+    closure never made its whole interval; a channel never made its interval times how far its area stayed from
+    the channel's range, as a share of the channel's area (at most all of it)."""
+    out = 0.0
+    for g in goals:
+        k = g.segment
+        on, span = late[k], ends[k] - starts[k]
+        if np.isfinite(on):
+            out += max(on - SLACK_MS, 0.0) + max(early[k] - SLACK_MS, 0.0)
+            continue
+        share = 1.0
+        if g.floor_cm2 > 0 and areas is not None:
+            inside = areas[k][(t >= starts[k] / 1e3) & (t < ends[k] / 1e3)]
+            if len(inside):
+                gap = g.floor_cm2 - inside.max() if inside.max() <= g.floor_cm2 else inside.min() - g.reach_cm2
+                share = min(max(gap, 0.0) / (0.5 * (g.floor_cm2 + g.reach_cm2)), 1.0)
+        out += span * share
+    return float(out)
 
 
 def _lead_more(leads: np.ndarray, starts: np.ndarray, k: int, by_ms: float, free: list[bool]) -> bool:

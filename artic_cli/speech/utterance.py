@@ -21,7 +21,8 @@ Example::
 
 A segment's ``lead_ms`` overrides the utterance's for its forces alone (a stop's closing gesture starts earlier,
 its release comes with the next segment's forces); ``press`` scales a solved target's tongue-muscle forces, up
-to ``muscles.max_force_n`` (a stop presses on the wall: a virtual target beyond it; the jaw's forces are kept).
+to ``muscles.max_force_n`` (a stop presses on the wall: a virtual target beyond it; the jaw's forces are kept;
+below 1 it softens them, as a channel too narrow needs).
 
 A target path is read relative to the working folder, else to the utterance file's folder.
 """
@@ -54,7 +55,7 @@ class Segment(Strict):
     cavity_expansion_cm3_s: Annotated[float, Field(ge=0, le=500, allow_inf_nan=False)] | None = None
     label: SafeName | None = None  # the TextGrid's label (default: the target's name)
     lead_ms: Annotated[float, Field(ge=0, le=300, allow_inf_nan=False)] | None = None  # else the utterance's
-    press: Annotated[float, Field(ge=1, le=3, allow_inf_nan=False)] = 1.0  # the target's tongue forces x this
+    press: Annotated[float, Field(ge=0.5, le=3, allow_inf_nan=False)] = 1.0  # the target's tongue forces x this (below 1: softer)
 
     @model_validator(mode="after")
     def _one_source(self):

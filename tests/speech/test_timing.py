@@ -25,3 +25,25 @@ def test_a_closure_never_made_reports_where_the_area_turned_back():
     area = 0.2 + np.abs(T - 0.150)  # narrowest at 150 ms, never below 0.2 cm^2
     late, early = onset_and_release(T, area, 0.01, 0.100, 0.200)
     assert np.isnan(late) and early == pytest.approx(50.0)
+
+
+def test_a_channel_is_not_made_by_the_closure_before_it():
+    area = np.where(T < 0.160, 0.0, 0.12)  # shut to 155 ms, then open to the channel's 0.1 +- 0.03 cm^2
+    late, early = onset_and_release(T, area, 0.13, 0.100, 0.200, floor=0.07)
+    assert late == pytest.approx(60.0) and early == 0.0
+    late, _ = onset_and_release(T, np.zeros_like(T), 0.13, 0.100, 0.200, floor=0.07)
+    assert np.isnan(late)
+
+
+def test_rounds_are_judged_by_how_much_of_the_constrictions_they_missed():
+    from artic_cli.speech.timing import Goal, missed_ms
+    starts, ends = np.array([0.0, 100.0, 150.0]), np.array([100.0, 150.0, 200.0])
+    goals = [Goal(1, 0, 0.01), Goal(2, 0, 0.13, 0.07)]
+    shut_channel = {1: np.zeros_like(T), 2: np.where(T < 0.150, 0.0, 0.035)}  # the channel half its floor
+    # a closure on time and a channel never opened beyond 0.035 cm^2 (half way to its 0.07 floor)
+    half = missed_ms(goals, {1: 0.0, 2: float("nan")}, {1: 0.0, 2: 0.0}, starts, ends, shut_channel, T)
+    assert half == pytest.approx(50.0 * 0.035 / 0.1)
+    # a closure never made costs its whole interval, however the channel does
+    assert missed_ms(goals, {1: float("nan"), 2: 0.0}, {1: 0.0, 2: 0.0}, starts, ends, shut_channel, T) == 50.0
+    # made 20 ms late and released 10 ms early: 17 + 7 ms beyond the slack
+    assert missed_ms(goals[:1], {1: 20.0}, {1: 10.0}, starts, ends) == pytest.approx(24.0)
