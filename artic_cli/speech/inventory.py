@@ -56,6 +56,7 @@ class Phoneme(Strict):
     formants_hz: Annotated[list[FormantHz], Field(min_length=2, max_length=3)] | None = None
     tongue_highest: Height | None = None
     palatalized: bool = False
+    closure_place: Place | None = None  # an affricate whose closure spans more than its channel's place
     duration_ms: DurationMs
 
     @model_validator(mode="after")
@@ -73,6 +74,8 @@ class Phoneme(Strict):
             raise ValueError(f"a {m} needs channel_cm2 (its narrowing at the place)")
         if m in ("nasal", "moraic_nasal") and self.velum_port_cm2 <= 0:
             raise ValueError("a nasal needs velum_port_cm2 > 0 (the port open)")
+        if self.closure_place is not None and m != "affricate":
+            raise ValueError("closure_place belongs to affricates (where the closure before the channel is made)")
         if m not in ("nasal", "moraic_nasal") and self.velum_port_cm2 > 0:
             raise ValueError("only nasals open the port (velum_port_cm2)")
         return self
@@ -115,8 +118,10 @@ class Inventory(Strict):
         if missing:
             raise ValueError(f"phonemes: missing {', '.join(missing)} (the inventory names {len(SYMBOLS)} symbols)")
         for sym, p in self.phonemes.items():
-            if p.place is not None and p.place not in self.places:
-                raise ValueError(f"phonemes.{sym}.place: '{p.place}' has no entry under 'places'")
+            for key in ("place", "closure_place"):
+                where = getattr(p, key)
+                if where is not None and where not in self.places:
+                    raise ValueError(f"phonemes.{sym}.{key}: '{where}' has no entry under 'places'")
             if p.place not in (None, "bilabial", "glottal") and p.jaw is None and p.place not in self.jaws:
                 raise ValueError(f"phonemes.{sym}: place '{p.place}' has no jaw; give the entry 'jaw' or add "
                                  f"jaws.{p.place}")

@@ -7,7 +7,7 @@ controls its inventory entry asks for (docs/inventory.md, "From a phoneme to a t
   follows (lip shape anticipates the vowel) unless it names its own.
 * A bilabial or glottal consonant leaves the tongue to its neighbours (``hold``: the previous segment's
   forces); the lips close (a tract entry) or the glottis opens.
-* An affricate is a closure then a channel, a palatalized consonant its consonant then the palatal glide, a
+* An affricate is a closure (at its ``closure_place`` if it names one) then a channel, a palatalized consonant its consonant then the palatal glide, a
   geminate the next consonant held a mora longer, the moraic nasal a closure at the next consonant's place:
   each part a segment of its own, the later parts ``continues`` (one TextGrid interval per phoneme).
 * A nasal opens the velum port ``nasal_margin_ms`` before it and closes it as long after it; a voiceless
@@ -97,7 +97,8 @@ def _parts(sym: str, p: Phoneme, inv: Inventory, lips, beside=()) -> list[tuple[
             tongue = constriction_target(f"{sym}_y", y, inv, y.channel_cm2, lips)
         return [(tongue, 1.0)]
     closure = p.manner in ("stop", "nasal", "tap", "affricate")
-    first = constriction_target(sym, p, inv, 0.0 if closure else p.channel_cm2, lips)
+    shut = p.model_copy(update={"place": p.closure_place}) if p.closure_place is not None else p
+    first = constriction_target(sym, shut, inv, 0.0 if closure else p.channel_cm2, lips)
     out = [(first, 1.0)]
     if p.manner == "affricate":
         share = inv.realisation.affricate_closure_share
