@@ -11,6 +11,8 @@ place read frame by frame, and the leads and presses moved by what was measured:
 * a channel never open to its area (an affricate's release after its closure) leads more and presses softer;
 * one released before its end (or, never made, narrowest before its end) delays the next segment's switch by
   as much.
+* one still held more than ``HELD_MS`` after its end brings the next segment's switch forward by as long
+  (a release on time: a stop's burst inside its interval, a voiced closure no longer than its voicing lasts).
 
 Leads keep the switches in order (``MIN_GAP_MS`` apart); a segment whose lead or press the utterance gives is
 left as given.  The rounds stop when nothing moves or every constriction is on time; the round that missed
@@ -38,6 +40,7 @@ SLACK_MS = 3.0  # reached within this of the start, held to within this of the e
 PRESS_STEP, PRESS_MAX = 1.15, 2.0
 LEAD_STEP_MS, LEAD_MAX_MS, MIN_GAP_MS = 20.0, 250.0, 10.0
 WINDOW_MS = 20.0  # a constriction made this long before its interval counts as reached at its start
+HELD_MS = 15.0  # a constriction held longer than this past its interval's end: the next segment leads more
 
 
 @dataclass
@@ -55,6 +58,7 @@ class Timing:
     rounds: int
     onset_late_ms: dict[int, float]  # per constriction segment: when its constriction was first made (NaN: never)
     released_early_ms: dict[int, float]  # ... how long before its end it opened again
+    held_late_ms: dict[int, float]  # ... how long after its end it still held
     trajectory: object = None  # the returned utterance's movement, when the last round simulated it as it is
 
 
@@ -97,6 +101,17 @@ def onset_and_release(t: np.ndarray, area: np.ndarray, reach: float, start: floa
     return 1e3 * onset, 1e3 * released
 
 
+def held_after(t: np.ndarray, area: np.ndarray, reach: float, end: float, floor: float = 0.0) -> float:
+    """How long (ms) a constriction made at ``end`` stays made after it (0 if it is open at its end)."""
+    ok = (area <= reach) & ((area > floor) if floor > 0 else True)
+    at = np.flatnonzero(t >= end - 1e-9)
+    if not len(at) or not ok[max(at[0] - 1, 0)]:
+        return 0.0
+    opened = at[~ok[at]]
+    last = float(t[opened[0]]) if len(opened) else float(t[-1])
+    return 1e3 * max(last - end, 0.0)
+
+
 def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[TargetSpec | None],
           rounds: int = ROUNDS) -> tuple[Utterance, Timing | None]:
     """The utterance with the leads and presses its constrictions need (see the module's text); unchanged, with
@@ -119,7 +134,7 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
         trial = _with(u, leads, press)
         traj, areas = place_areas(trial, p, cfg, model, rest, goals)
         t = traj.time
-        late, early = {}, {}
+        late, early, held = {}, {}, {}
         tried = leads.copy(), press.copy()
         changed = False
         for g in goals:
@@ -147,14 +162,18 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
             if off > SLACK_MS and k + 1 < len(segs) and free_lead[k + 1] and leads[k + 1] > 0:
                 leads[k + 1] = max(leads[k + 1] - off, 0.0)
                 changed = True
-        score = missed_ms(goals, late, early, starts, ends, areas, t)
+            held[k] = held_after(t, areas[g.segment], g.reach_cm2, ends[k] / 1e3, g.floor_cm2) if np.isfinite(on) else 0.0
+            if held[k] > HELD_MS and k + 1 < len(segs) and not segs[k + 1].continues:
+                changed |= _lead_more(leads, starts, k + 1, held[k], free_lead)
+        score = missed_ms(goals, late, early, starts, ends, areas, t) + sum(max(h - HELD_MS, 0.0) for h in held.values())
         if best is None or score < best[0]:
-            best = (score, r, tried, late, early, traj)
+            best = (score, r, tried, late, early, held, traj)
         if not changed or score == 0.0:
             break
-    score, at, (leads, press), late, early, traj = best
+    score, at, (leads, press), late, early, held, traj = best
     return _with(u, leads, press), Timing(leads_ms=leads.tolist(), press=press.tolist(), rounds=r + 1,
-                                          onset_late_ms=late, released_early_ms=early, trajectory=traj)
+                                          onset_late_ms=late, released_early_ms=early, held_late_ms=held,
+                                          trajectory=traj)
 
 
 def missed_ms(goals: list[Goal], late: dict, early: dict, starts: np.ndarray, ends: np.ndarray,

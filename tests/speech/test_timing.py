@@ -47,3 +47,10 @@ def test_rounds_are_judged_by_how_much_of_the_constrictions_they_missed():
     assert missed_ms(goals, {1: float("nan"), 2: 0.0}, {1: 0.0, 2: 0.0}, starts, ends, shut_channel, T) == 50.0
     # made 20 ms late and released 10 ms early: 17 + 7 ms beyond the slack
     assert missed_ms(goals[:1], {1: 20.0}, {1: 10.0}, starts, ends) == pytest.approx(24.0)
+
+
+def test_a_closure_held_past_its_interval_is_measured_to_its_release():
+    from artic_cli.speech.timing import held_after
+    area = np.where((T >= 0.090) & (T < 0.240), 0.0, 0.5)  # shut to 235 ms, its interval ending at 200 ms
+    assert held_after(T, area, 0.01, 0.200) == pytest.approx(40.0)
+    assert held_after(T, np.where(T < 0.190, 0.0, 0.5), 0.01, 0.200) == 0.0  # open at its end
