@@ -11,6 +11,8 @@ place read frame by frame, and the leads and presses moved by what was measured:
 * a channel never open to its area (an affricate's release after its closure) leads more and presses softer;
 * one released before its end (or, never made, narrowest before its end) delays the next segment's switch by
   as much.
+* one made more than ``EARLY_MS`` before its start leads less by as much, less ``WINDOW_MS`` (a tap between
+  high vowels, whose tongue is near the ridge already);
 * one still held more than ``HELD_MS`` after its end brings the next segment's switch forward by as long
   (a release on time: a stop's burst inside its interval, a voiced closure no longer than its voicing lasts).
 
@@ -41,6 +43,7 @@ PRESS_STEP, PRESS_MAX = 1.15, 2.0
 LEAD_STEP_MS, LEAD_MAX_MS, MIN_GAP_MS = 20.0, 250.0, 10.0
 WINDOW_MS = 20.0  # a constriction made this long before its interval counts as reached at its start
 HELD_MS = 15.0  # a constriction held longer than this past its interval's end: the next segment leads more
+EARLY_MS = 40.0  # ... made longer than this before its start: its own segment leads less
 
 
 @dataclass
@@ -112,6 +115,17 @@ def held_after(t: np.ndarray, area: np.ndarray, reach: float, end: float, floor:
     return 1e3 * max(last - end, 0.0)
 
 
+def made_before(t: np.ndarray, area: np.ndarray, reach: float, start: float, floor: float = 0.0) -> float:
+    """How long (ms) before ``start`` a constriction made at its start was first made (0 if not made then)."""
+    ok = (area <= reach) & ((area > floor) if floor > 0 else True)
+    at = np.flatnonzero(t <= start + 1e-9)
+    if not len(at) or not ok[at[-1]]:
+        return 0.0
+    shut = at[~ok[at]]
+    first = float(t[shut[-1] + 1]) if len(shut) else float(t[0])
+    return 1e3 * max(start - first, 0.0)
+
+
 def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[TargetSpec | None],
           rounds: int = ROUNDS) -> tuple[Utterance, Timing | None]:
     """The utterance with the leads and presses its constrictions need (see the module's text); unchanged, with
@@ -126,15 +140,13 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
     free_press = [s.press == 1.0 for s in segs]  # (a press below 1 softens a channel's forces)
     starts = np.array(u.starts_ms(), float)
     ends = starts + np.array([s.duration_ms for s in segs])
-    for k in range(1, len(segs)):  # a short part (an affricate's release, a glide) leads no more than fits
-        if free_lead[k]:
-            leads[k] = max(min(leads[k], starts[k] - (starts[k - 1] - leads[k - 1]) - MIN_GAP_MS), 0.0)
+    _in_order(leads, starts, free_lead)  # a short part (an affricate's release, a glide) leads no more than fits
     best = None
     for r in range(rounds):
         trial = _with(u, leads, press)
         traj, areas = place_areas(trial, p, cfg, model, rest, goals)
         t = traj.time
-        late, early, held = {}, {}, {}
+        late, early, held, soon = {}, {}, {}, {}
         tried = leads.copy(), press.copy()
         changed = False
         for g in goals:
@@ -162,10 +174,17 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
             if off > SLACK_MS and k + 1 < len(segs) and free_lead[k + 1] and leads[k + 1] > 0:
                 leads[k + 1] = max(leads[k + 1] - off, 0.0)
                 changed = True
+            ahead = made_before(t, areas[g.segment], g.reach_cm2, starts[k] / 1e3, g.floor_cm2)
+            soon[k] = ahead
+            if ahead > EARLY_MS and free_lead[k] and leads[k] > 0 and not segs[k].continues:
+                leads[k] = max(leads[k] - (ahead - WINDOW_MS), 0.0)
+                changed = True
             held[k] = held_after(t, areas[g.segment], g.reach_cm2, ends[k] / 1e3, g.floor_cm2) if np.isfinite(on) else 0.0
             if held[k] > HELD_MS and k + 1 < len(segs) and not segs[k + 1].continues:
                 changed |= _lead_more(leads, starts, k + 1, held[k], free_lead)
+        _in_order(leads, starts, free_lead)
         score = missed_ms(goals, late, early, starts, ends, areas, t) + sum(max(h - HELD_MS, 0.0) for h in held.values())
+        score += sum(max(a - EARLY_MS, 0.0) for a in soon.values())
         if best is None or score < best[0]:
             best = (score, r, tried, late, early, held, traj)
         if not changed or score == 0.0:
@@ -196,6 +215,13 @@ def missed_ms(goals: list[Goal], late: dict, early: dict, starts: np.ndarray, en
                 share = min(max(gap, 0.0) / (0.5 * (g.floor_cm2 + g.reach_cm2)), 1.0)
         out += span * share
     return float(out)
+
+
+def _in_order(leads: np.ndarray, starts: np.ndarray, free: list[bool]) -> None:
+    """Each free lead cut to switch at least ``MIN_GAP_MS`` after the segment before it (in place)."""
+    for k in range(1, len(leads)):
+        if free[k]:
+            leads[k] = max(min(leads[k], starts[k] - (starts[k - 1] - leads[k - 1]) - MIN_GAP_MS), 0.0)
 
 
 def _lead_more(leads: np.ndarray, starts: np.ndarray, k: int, by_ms: float, free: list[bool]) -> bool:

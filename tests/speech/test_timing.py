@@ -54,3 +54,10 @@ def test_a_closure_held_past_its_interval_is_measured_to_its_release():
     area = np.where((T >= 0.090) & (T < 0.240), 0.0, 0.5)  # shut to 235 ms, its interval ending at 200 ms
     assert held_after(T, area, 0.01, 0.200) == pytest.approx(40.0)
     assert held_after(T, np.where(T < 0.190, 0.0, 0.5), 0.01, 0.200) == 0.0  # open at its end
+
+
+def test_a_closure_made_long_before_its_interval_is_measured_from_its_making():
+    from artic_cli.speech.timing import made_before
+    area = np.where((T >= 0.030) & (T < 0.150), 0.0, 0.5)  # shut from 30 ms, its interval starting at 100 ms
+    assert made_before(T, area, 0.01, 0.100) == pytest.approx(70.0)
+    assert made_before(T, np.where(T >= 0.120, 0.0, 0.5), 0.01, 0.100) == 0.0  # open at its start
