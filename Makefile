@@ -49,7 +49,7 @@ $(CONFIG):
 	@echo "error: config not found: $@; give an existing file, e.g. CONFIG=configs/default.yaml" >&2; exit 2
 
 # one file per config section, rewritten only when that section changes
-$(OUT)/.config/.stamp: $(CONFIG) | setup
+$(OUT)/.config/.stamp: $(CONFIG) $(wildcard artic_cli/config/*.py) | setup
 	$(PY) -m artic_cli.pipeline sections $(CONFIG) $(OUT)/.config
 	@touch $@
 $(OUT)/.config/%.json: $(OUT)/.config/.stamp ;
