@@ -57,6 +57,7 @@ class Phoneme(Strict):
     tongue_highest: Height | None = None
     palatalized: bool = False
     closure_place: Place | None = None  # an affricate whose closure spans more than its channel's place
+    like: str | None = None  # a glide: the vowel whose tongue it narrows (its non-syllabic counterpart)
     duration_ms: DurationMs
 
     @model_validator(mode="after")
@@ -74,6 +75,8 @@ class Phoneme(Strict):
             raise ValueError(f"a {m} needs channel_cm2 (its narrowing at the place)")
         if m in ("nasal", "moraic_nasal") and self.velum_port_cm2 <= 0:
             raise ValueError("a nasal needs velum_port_cm2 > 0 (the port open)")
+        if self.like is not None and m != "approximant":
+            raise ValueError("like belongs to glides (approximants): the vowel whose tongue a glide narrows")
         if self.closure_place is not None and m != "affricate":
             raise ValueError("closure_place belongs to affricates (where the closure before the channel is made)")
         if m not in ("nasal", "moraic_nasal") and self.velum_port_cm2 > 0:
@@ -118,6 +121,8 @@ class Inventory(Strict):
         if missing:
             raise ValueError(f"phonemes: missing {', '.join(missing)} (the inventory names {len(SYMBOLS)} symbols)")
         for sym, p in self.phonemes.items():
+            if p.like is not None and (p.like not in self.phonemes or self.phonemes[p.like].manner != "vowel"):
+                raise ValueError(f"phonemes.{sym}.like: '{p.like}' is not a vowel of the inventory")
             for key in ("place", "closure_place"):
                 where = getattr(p, key)
                 if where is not None and where not in self.places:

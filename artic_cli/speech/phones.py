@@ -16,13 +16,16 @@ controls its inventory entry asks for (docs/inventory.md, "From a phoneme to a t
 
 from __future__ import annotations
 
-from ..control.solver import LIP_SHAPES
+from typing import Callable
+
+from ..control.solver import LIP_SHAPES, parse_target
 from ..errors import ArticError
 from ..schedule import TractEntry
 from .inventory import Inventory, Phoneme
 from .utterance import Segment, Utterance
 
 TONGUELESS = ("bilabial", "glottal")  # places the tongue does not make
+TongueOf = Callable[[str], dict[str, list[float]]]  # a vowel's symbol -> {"tip": [x, y], "dorsum": [x, y]} (cm)
 
 
 def _lips(p: Phoneme):
@@ -85,7 +88,18 @@ def _next_consonant(symbols: list[str], k: int, inv: Inventory) -> str | None:
     return s if s is not None and inv.phonemes[s].manner not in ("vowel", "geminate", "moraic_nasal") else None
 
 
-def _parts(sym: str, p: Phoneme, inv: Inventory, lips, beside=()) -> list[tuple[dict | None, float]]:
+def glide_target(sym: str, g: Phoneme, inv: Inventory, lips, tongue_of: TongueOf | None = None) -> dict:
+    """A glide's narrowing at its place; one ``like`` a vowel keeps the tip and dorsum where that vowel has them
+    as far as the narrowing lets it (indecisive points: [j] is /i/'s tongue narrowed, not any tongue that
+    narrows the palate), when ``tongue_of`` tells where."""
+    t = constriction_target(sym, g, inv, g.channel_cm2, lips)
+    if g.like is not None and tongue_of is not None:
+        t["indecisive"] = [{"point": k, "at_cm": [round(float(c), 4) for c in xy]} for k, xy in tongue_of(g.like).items()]
+    return t
+
+
+def _parts(sym: str, p: Phoneme, inv: Inventory, lips, beside=(), tongue_of: TongueOf | None = None
+           ) -> list[tuple[dict | None, float]]:
     """(target or None (hold the tongue), share of the duration) of each part of a phoneme (``beside``: a
     vowel's neighbouring consonants)."""
     if p.manner == "vowel":
@@ -94,11 +108,12 @@ def _parts(sym: str, p: Phoneme, inv: Inventory, lips, beside=()) -> list[tuple[
         tongue = None
         if p.palatalized:  # the tongue body takes the palatal glide's place during the lips' or glottis' gesture
             y = inv.phonemes["y"]
-            tongue = constriction_target(f"{sym}_y", y, inv, y.channel_cm2, lips)
+            tongue = glide_target(f"{sym}_y", y, inv, lips, tongue_of)
         return [(tongue, 1.0)]
     closure = p.manner in ("stop", "nasal", "tap", "affricate")
     shut = p.model_copy(update={"place": p.closure_place}) if p.closure_place is not None else p
-    first = constriction_target(sym, shut, inv, 0.0 if closure else p.channel_cm2, lips)
+    first = (glide_target(sym, p, inv, lips, tongue_of) if p.manner == "approximant" else
+             constriction_target(sym, shut, inv, 0.0 if closure else p.channel_cm2, lips))
     out = [(first, 1.0)]
     if p.manner == "affricate":
         share = inv.realisation.affricate_closure_share
@@ -107,7 +122,7 @@ def _parts(sym: str, p: Phoneme, inv: Inventory, lips, beside=()) -> list[tuple[
         y = inv.phonemes["y"]
         share = inv.realisation.palatal_glide_share
         out = [(t, s * (1 - share)) for t, s in out] + [
-            (constriction_target(f"{sym}_y", y, inv, y.channel_cm2, lips), share)]
+            (glide_target(f"{sym}_y", y, inv, lips, tongue_of), share)]
     return out
 
 
@@ -139,9 +154,11 @@ def _stand_in(symbols: list[str], k: int, inv: Inventory) -> Phoneme:
     return n if n.place == place else n.model_copy(update={"place": place, "lips": "neutral"})
 
 
-def realise(u: Utterance, inv: Inventory, default_lips: tuple[float, float]) -> Utterance:
+def realise(u: Utterance, inv: Inventory, default_lips: tuple[float, float], tongue_of: TongueOf | None = None
+            ) -> Utterance:
     """The utterance with every ``phoneme`` segment made into target and hold segments and tract entries
-    (``default_lips``: the config's lip tube, area cm^2 and length cm, for neutral lips)."""
+    (``default_lips``: the config's lip tube, area cm^2 and length cm, for neutral lips; ``tongue_of``: where a
+    vowel puts the tip and dorsum, for the glides like it)."""
     if not any(s.phoneme is not None for s in u.segments):
         return u
     symbols = [s.phoneme for s in u.segments]
@@ -165,7 +182,7 @@ def realise(u: Utterance, inv: Inventory, default_lips: tuple[float, float]) -> 
         closing = voiced and p.manner in ("stop", "affricate", "tap") and p.velum_port_cm2 == 0 and sym not in ("N", "Q")
         expand = inv.realisation.voiced_stop_expansion_cm3_s if closing else None
         beside = [_neighbour(symbols, k, d, inv) for d in (-1, 1)] if p.manner == "vowel" else []
-        for n, (target, share) in enumerate(_parts(sym, p, inv, lips, beside)):
+        for n, (target, share) in enumerate(_parts(sym, p, inv, lips, beside, tongue_of)):
             common = dict(duration_ms=seg.duration_ms * share, voiced=voiced, glottis_cm2=glottis,
                           label=sym if n == 0 else None, continues=n > 0, cavity_expansion_cm3_s=expand)
             segments.append(Segment(target=target, **common) if target is not None else Segment(hold=True, **common))
@@ -185,6 +202,21 @@ def realise(u: Utterance, inv: Inventory, default_lips: tuple[float, float]) -> 
         t += seg.duration_ms
     tract += _port_entries(nasal_runs, inv.realisation.nasal_margin_ms, u.duration_ms)
     return u.model_copy(update={"segments": segments, "tract": tract})
+
+
+def vowel_tongues(inv: Inventory, solve, max_force_n: float) -> TongueOf:
+    """Where each vowel's solved target puts the tip and dorsum (cm; the refinement's simulated points, else the
+    maps' prediction), each vowel solved once by ``solve`` (targets -> answers with their documents)."""
+    known: dict[str, dict[str, list[float]]] = {}
+
+    def tongue_of(v: str) -> dict[str, list[float]]:
+        if v not in known:
+            t = parse_target(vowel_target(v, inv.phonemes[v], inv), f"inventory: phonemes.{v}", max_force_n)
+            doc = solve([t])[0].doc or {}
+            points = (doc.get("refined") or {}).get("reached_cm") or (doc.get("chosen") or {}).get("predicted_cm") or {}
+            known[v] = {k: [float(c) for c in xy] for k, xy in points.items() if k in ("tip", "dorsum")}
+        return known[v]
+    return tongue_of
 
 
 def _tube(lips, default_lips: tuple[float, float]) -> tuple[float, float]:
@@ -210,4 +242,4 @@ def _port_entries(runs: list[tuple[float, float, float]], margin_ms: float, tota
     return out
 
 
-__all__ = ["realise", "vowel_target", "constriction_target"]
+__all__ = ["TongueOf", "constriction_target", "glide_target", "realise", "vowel_target"]

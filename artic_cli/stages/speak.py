@@ -30,7 +30,7 @@ from ..speech.speak import Spoken, speak_plan
 from ..speech.textgrid import write_textgrid
 from ..speech.inventory import DEFAULT as DEFAULT_INVENTORY
 from ..speech.inventory import load_inventory
-from ..speech.phones import realise
+from ..speech.phones import realise, vowel_tongues
 from ..speech.timing import timed
 from ..speech.utterance import Utterance, check_forces, load_utterance
 from ..tract.places import section_places
@@ -178,15 +178,17 @@ def _check_out(out: Path | str) -> Path:
     return out
 
 
-def with_phonemes(u: Utterance, cfg: Config, inventory: Path | str | None = None) -> Utterance:
+def with_phonemes(u: Utterance, cfg: Config, inventory: Path | str | None = None, solve=None) -> Utterance:
     """The utterance with its phoneme segments made targets and controls (the inventory read only if it has
-    any; its places checked against the config's tract)."""
+    any; its places checked against the config's tract); ``solve`` (targets -> answers) places a glide's tongue
+    like its vowel's, as that vowel's target solves."""
     if not any(s.phoneme is not None for s in u.segments):
         return u
     inv = load_inventory(inventory or DEFAULT_INVENTORY)
     vt = speaker_tract(cfg)
     inv.check_places(section_places(vt)[1], str(inventory or DEFAULT_INVENTORY))
-    return realise(u, inv, (float(vt.lips.area_cm2), float(vt.lips.length_cm)))
+    return realise(u, inv, (float(vt.lips.area_cm2), float(vt.lips.length_cm)),
+                   None if solve is None else vowel_tongues(inv, solve, cfg.muscles.max_force_n))
 
 
 def speak(utterance: Path | str | Utterance, out: Path | str | None = None, maps: Path | str = paths.EPMAPS,
@@ -203,10 +205,11 @@ def speak(utterance: Path | str | Utterance, out: Path | str | None = None, maps
     source = None if isinstance(utterance, Utterance) else utterance
     u = utterance if source is None else load_utterance(source)
     cfg = load_config(config)
-    u = with_phonemes(u, cfg, inventory)
     out = _check_out(out if out is not None else paths.UTTERANCES / f"{u.name}.wav")
-    m = mesh_stage.read(mesh, cfg)
     folder = Path(solutions) if solutions is not None else out.parent / "solutions"
+    u = with_phonemes(u, cfg, inventory, partial(solve_runs.solve_batch, maps=maps, mesh=mesh, acoustic_maps=acoustic_maps,
+                                                 config=config, folder=folder, budget=budget, jobs=jobs, dynamic=None))
+    m = mesh_stage.read(mesh, cfg)
     targets = segment_targets(u, source, cfg.muscles.max_force_n)
     # the recipe: what the targets are solved on and with, so an unchanged utterance is known without solving
     inputs = {"mesh": m.content_sha256, "utterance": digest(u.model_dump(mode="json")),
