@@ -7,9 +7,12 @@ controls its inventory entry asks for (docs/inventory.md, "From a phoneme to a t
   follows (lip shape anticipates the vowel) unless it names its own.
 * A bilabial or glottal consonant leaves the tongue to its neighbours (``hold``: the previous segment's
   forces); the lips close (a tract entry) or the glottis opens.
-* An affricate is a closure (at its ``closure_place`` if it names one) then a channel, a palatalized consonant its consonant then the palatal glide, a
-  geminate the next consonant held a mora longer, the moraic nasal a closure at the next consonant's place:
-  each part a segment of its own, the later parts ``continues`` (one TextGrid interval per phoneme).
+* A glide is a narrowing at its place; one ``like`` a vowel keeps that vowel's tip and dorsum as indecisive
+  points.
+* An affricate is a closure (at its ``closure_place`` if it names one) then a channel, a palatalized consonant
+  its consonant then the palatal glide, a geminate the next consonant held a mora longer, the moraic nasal a
+  closure at the next consonant's place: each part a segment of its own, the later parts ``continues`` (one
+  TextGrid interval per phoneme).
 * A nasal opens the velum port ``nasal_margin_ms`` before it and closes it as long after it; a voiceless
   phoneme abducts the glottis (its ``glottis_cm2`` or the config's voiceless opening).
 """

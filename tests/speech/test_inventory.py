@@ -39,6 +39,10 @@ def test_the_inventory_names_every_symbol_with_features_and_places_the_tract_has
     (lambda d: d["phonemes"]["a"].update(jaw="JO_six"), "phonemes.a.jaw"),
     (lambda d: d["phonemes"]["a"].update(jaw={"forces_n": {"JO": 6}}), "names jaw positions"),
     (lambda d: d["jaws"].update(velar="JX_1"), "jaws.velar"),
+    (lambda d: d["phonemes"]["k"].update(like="a"), "like belongs to glides"),
+    (lambda d: d["phonemes"]["y"].update(like="k"), "phonemes.y.like: 'k' is not a vowel"),
+    (lambda d: d["phonemes"]["s"].update(closure_place="alveolar"), "closure_place belongs to affricates"),
+    (lambda d: d["phonemes"]["ch"].update(closure_place="uvular"), "phonemes.ch.closure_place"),
 ])
 def test_a_bad_inventory_is_one_error_naming_the_key(tmp_path, change, says):
     d = yaml.safe_load(DEFAULT.read_text())
