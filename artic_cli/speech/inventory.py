@@ -97,6 +97,8 @@ class Realisation(Strict):
     channel_tolerance: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = 0.3  # a share of the channel
     affricate_closure_share: Share = 0.5  # of an affricate's duration, the rest its channel
     palatal_glide_share: Share = 0.4  # of a palatalized consonant's duration: the glide to the palate after it
+    palatal_glide_cm2: Annotated[float, Field(gt=0, le=2, allow_inf_nan=False)] = 0.3  # ... its narrowing (a
+    # secondary articulation, wider than the glide /y/'s own)
     nasal_margin_ms: Ms = 30.0  # the port opens this long before a nasal and closes as long after it
     lip_closing_ms: Ms = 20.0  # a bilabial's lips close over this, shut at its start
     lip_opening_ms: Ms = 15.0  # ... and open over this from its end

@@ -111,7 +111,7 @@ def _parts(sym: str, p: Phoneme, inv: Inventory, lips, beside=(), tongue_of: Ton
         tongue = None
         if p.palatalized:  # the tongue body takes the palatal glide's place during the lips' or glottis' gesture
             y = inv.phonemes["y"]
-            tongue = glide_target(f"{sym}_y", y, inv, lips, tongue_of)
+            tongue = glide_target(f"{sym}_y", _colouring(inv), inv, lips)
         return [(tongue, 1.0)]
     closure = p.manner in ("stop", "nasal", "tap", "affricate")
     shut = p.model_copy(update={"place": p.closure_place}) if p.closure_place is not None else p
@@ -125,7 +125,7 @@ def _parts(sym: str, p: Phoneme, inv: Inventory, lips, beside=(), tongue_of: Ton
         y = inv.phonemes["y"]
         share = inv.realisation.palatal_glide_share
         out = [(t, s * (1 - share)) for t, s in out] + [
-            (glide_target(f"{sym}_y", y, inv, lips, tongue_of), share)]
+            (glide_target(f"{sym}_y", _colouring(inv), inv, lips), share)]
     return out
 
 
@@ -188,6 +188,8 @@ def realise(u: Utterance, inv: Inventory, default_lips: tuple[float, float], ton
         for n, (target, share) in enumerate(_parts(sym, p, inv, lips, beside, tongue_of)):
             common = dict(duration_ms=seg.duration_ms * share, voiced=voiced, glottis_cm2=glottis,
                           label=sym if n == 0 else None, continues=n > 0, cavity_expansion_cm3_s=expand)
+            if target is not None and _is_glide(target, inv):  # a glide undershoots in a short interval: no press
+                common["press"] = 1.0
             segments.append(Segment(target=target, **common) if target is not None else Segment(hold=True, **common))
         if p.lips == "closed" or (p.place == "bilabial" and p.manner == "fricative"):
             area = 0.0 if p.lips == "closed" else p.channel_cm2
@@ -220,6 +222,20 @@ def vowel_tongues(inv: Inventory, solve, max_force_n: float) -> TongueOf:
             known[v] = {k: [float(c) for c in xy] for k, xy in points.items() if k in ("tip", "dorsum")}
         return known[v]
     return tongue_of
+
+
+def _colouring(inv: Inventory) -> Phoneme:
+    """A palatalized consonant's glide: /y/'s place at the wider ``palatal_glide_cm2``, no vowel's tongue (a
+    secondary articulation in a short part)."""
+    return inv.phonemes["y"].model_copy(update={"channel_cm2": inv.realisation.palatal_glide_cm2, "like": None})
+
+
+def _is_glide(target: dict, inv: Inventory) -> bool:
+    """Whether a target is a glide's narrowing (a glide's own, or a palatalized consonant's glide)."""
+    c = target.get("constriction")
+    glides = [p for p in inv.phonemes.values() if p.manner == "approximant"] + [_colouring(inv)]
+    return c is not None and any(c["area_cm2"] == p.channel_cm2 and c["place"] == inv.places.get(p.place)
+                                 for p in glides)
 
 
 def _tube(lips, default_lips: tuple[float, float]) -> tuple[float, float]:

@@ -137,7 +137,7 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
     leads = np.array(u.leads_ms(default_leads_ms(u, cfg)[0]), float)
     press = np.array([s.press for s in segs], float)
     free_lead = [s.lead_ms is None for s in segs]
-    free_press = [s.press == 1.0 for s in segs]  # (a press below 1 softens a channel's forces)
+    free_press = ["press" not in s.model_fields_set for s in segs]  # given (a glide's 1): kept; below 1 softens
     starts = np.array(u.starts_ms(), float)
     ends = starts + np.array([s.duration_ms for s in segs])
     _in_order(leads, starts, free_lead)  # a short part (an affricate's release, a glide) leads no more than fits

@@ -87,7 +87,8 @@ def test_a_palatalized_stop_glides_to_the_palate_after_its_closure(inv):
     u = spoken("kya", inv)
     k, y = u.segments[:2]
     assert k.target["constriction"]["area_cm2"] == 0.0 and y.continues
-    assert y.target["constriction"] == {"place": "hard palate", "area_cm2": 0.15, "tolerance_cm2": 0.045}
+    assert y.target["constriction"] == {"place": "hard palate", "area_cm2": 0.3, "tolerance_cm2": 0.09}
+    assert y.press == 1.0 and "press" in y.model_fields_set  # a glide is not pressed by the timing
 
 
 def test_ch_closes_at_the_ridge_and_releases_behind_it(inv):
@@ -104,11 +105,11 @@ def test_a_glide_like_a_vowel_keeps_that_vowel_s_tongue_where_it_is_told(inv):
         return {"tip": [-0.8, -0.55], "dorsum": [-4.1, 1.54]}
 
     y = realise(utterance_of_text("aya", inv), inv, LIPS, tongue_of).segments[1].target
-    assert asked == ["i"] and y["constriction"]["area_cm2"] == 0.15
+    assert asked == ["i"] and y["constriction"]["area_cm2"] == inv.phonemes["y"].channel_cm2
     assert y["indecisive"] == [{"point": "tip", "at_cm": [-0.8, -0.55]}, {"point": "dorsum", "at_cm": [-4.1, 1.54]}]
     parse_target(y)  # a valid target
     kya = realise(utterance_of_text("kya", inv), inv, LIPS, tongue_of).segments[1].target
-    assert kya["indecisive"] == y["indecisive"]  # the palatalized consonant's glide too
+    assert "indecisive" not in kya  # a palatalized consonant's glide: a secondary narrowing of its own
     assert "indecisive" not in spoken("aya", inv).segments[1].target  # told nothing: none
     assert "indecisive" not in realise(utterance_of_text("awa", inv), inv, LIPS, tongue_of).segments[1].target
 

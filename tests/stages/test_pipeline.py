@@ -258,3 +258,28 @@ def test_the_html_report_opens_in_a_browser_with_every_picture_and_sound(built, 
     sounds = re.findall(r'<audio[^>]* src="([^"]+)"', text)
     assert len(got["audio"]) == len(sounds) >= 7, got["audio"]  # the rest tract, five vowels, an utterance
     assert all(d > 0 and err == 0 for _, d, err in got["audio"]), got["audio"]
+
+
+def test_the_pipelines_vowels_hold_the_tongue_highest_where_the_inventory_says(built):
+    """Each vowel's refined forces held as `artic simulate` holds them: the highest points of the five tongues
+    keep the inventory's order (high above mid above low, front before back; speech/tongue_height.py)."""
+    import yaml
+
+    from artic_cli.config import load_config
+    from artic_cli.control.verify import Simulator
+    from artic_cli.speech.inventory import load_inventory
+    from artic_cli.speech.tongue_height import highest_point, misordered
+    from artic_cli.stages import mesh as mesh_stage
+    from artic_cli.tract.shapes import surface_nodes
+
+    cfg = load_config(ROOT / "configs" / "ci_thin.yaml")
+    m = mesh_stage.read(built / "mesh.h5", cfg)
+    sim, (mid, _) = Simulator(cfg, m.mesh, m.wall, m.content_sha256), surface_nodes(m.mesh)
+    points = {}
+    for v in "aeiou":
+        doc = yaml.safe_load((built / "vowels" / f"{v}.yaml").read_text())
+        answer = doc.get("refined") or doc.get("chosen") or doc["nearest"]
+        x, _ = sim.shape(doc["jaw"]["forces_n"], answer["forces_n"])
+        points[v] = highest_point(x[mid, :2])
+    named = {v: p.tongue_highest for v, p in load_inventory().phonemes.items() if p.manner == "vowel"}
+    assert misordered(points, named) == [], points
