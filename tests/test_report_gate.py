@@ -11,7 +11,7 @@ ACCEPTED = ("Cuboid: apparent Poisson ratio, Eq. (4)", "Figs. 5/6: GGp from", "T
             "Table III contribution factor of GGp ", "Table III contribution factor of SG ",
             "Table IV: derived vs simulated map, jaw JO_6 ", "Consonant landmarks",
             "Articulators (issue 45", "/acha/: peak speeds", "/aja/: peak speeds", "/anya/: peak speeds",
-            "/aka/: closure", "/asa/: level above 3 kHz")
+            "/aka/: closure", "/asa/: level above 3 kHz", "Vowels beside the consonants (issue 45")
 
 
 def test_the_default_speakers_report_differs_only_where_accepted():

@@ -360,3 +360,23 @@ def test_the_reports_voicing_is_praats_within_0_15(spoken, c):
     y, rate = read_wav(wav)
     ours, praat = share_voiced(y, rate, C0, C1), _voiced(wav, C0, C1)
     assert abs(ours - praat) <= 0.15, (ours, praat)
+
+
+@pytest.mark.parametrize("c", ["m", "t", "h"])
+def test_the_reports_vowel_classes_are_what_praat_hears(spoken, c):
+    """speech/vowel_class.py on the model's formant tracks and on Praat's (Burg) over the same vowels' middle
+    halves: the same nearest male Japanese mean for each vowel, F1 and F2 within 10 %."""
+    from artic_cli.speech.inventory import load_inventory
+    from artic_cli.speech.vowel_class import heard_vowels, nearest_vowel
+
+    from conftest import praat_formants_near
+
+    means = {v: tuple(p.formants_hz[:2]) for v, p in load_inventory().phonemes.items() if p.manner == "vowel"}
+    rec = speak.read(spoken / f"a{c}a.h5")
+    ivs = [(0.0, 0.22, "a"), (0.30, 0.52, "a")]
+    ours = heard_vowels(ivs, rec.time_s, rec.formants_hz, means)
+    for (t0, t1, _), h in zip(ivs, ours):
+        q = 0.25 * (t1 - t0)
+        heard, _ = praat_formants_near(spoken / f"a{c}a.wav", np.linspace(t0 + q, t1 - q, 7), [h["f1_hz"], h["f2_hz"]])
+        assert nearest_vowel(heard[0], heard[1], means) == h["heard"], (c, t0, heard, h)
+        assert abs(heard[0] / h["f1_hz"] - 1) <= 0.10 and abs(heard[1] / h["f2_hz"] - 1) <= 0.10, (heard, h)

@@ -1,0 +1,33 @@
+"""Which vowel a vowel interval sounds like: its F1 and F2 (medians over the interval's middle half) against the
+five male Japanese means, the nearest in Bark (Traunmueller's scale, ``units.hz_to_bark``) its class."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import units
+
+
+def nearest_vowel(f1_hz: float, f2_hz: float, means_hz: dict[str, tuple[float, float]]) -> str:
+    """The vowel whose mean (F1, F2 Hz) lies nearest (F1, F2) in Bark."""
+    z = units.hz_to_bark(np.array([f1_hz, f2_hz], float))
+    return min(means_hz, key=lambda v: float(np.sum((units.hz_to_bark(np.asarray(means_hz[v][:2], float)) - z) ** 2)))
+
+
+def heard_vowels(intervals: list[tuple[float, float, str]], time_s: np.ndarray, formants_hz: np.ndarray,
+                 means_hz: dict[str, tuple[float, float]]) -> list[dict]:
+    """Each interval labelled with a vowel of ``means_hz``: its F1 and F2 over its middle half (the formant tracks
+    ``formants_hz`` (F, >= 2) at ``time_s``) and the vowel nearest them."""
+    out = []
+    for t0, t1, label in intervals:
+        if label not in means_hz:
+            continue
+        q = 0.25 * (t1 - t0)
+        inside = (time_s >= t0 + q) & (time_s <= t1 - q)
+        f1, f2 = (float(np.nanmedian(formants_hz[inside, k])) if inside.any() else float("nan") for k in (0, 1))
+        heard = nearest_vowel(f1, f2, means_hz) if np.isfinite(f1) and np.isfinite(f2) else ""
+        out.append({"label": label, "start_s": t0, "f1_hz": f1, "f2_hz": f2, "heard": heard, "ok": heard == label})
+    return out
+
+
+__all__ = ["heard_vowels", "nearest_vowel"]
