@@ -25,7 +25,8 @@ PIPELINE = "PIPELINE=pipelines/ci.yaml"  # the paper pipeline with fewer utteran
 CI_ACCEPTED = ("Cuboid: apparent Poisson ratio, Eq. (4)", "Figs. 5/6: GGp from", "Table III contribution factor of GGm ",
                "Table III contribution factor of GGp ", "Table III contribution factor of SG ",
                "Table IV: derived vs simulated map, jaw JO_6 ", "Table III contribution factor of HG ",
-               "EP maps in the F1-F2 plane", "/aka/: closure", "Consonant landmarks", "Articulators (issue 45")
+               "EP maps in the F1-F2 plane", "/aka/: closure", "Consonant landmarks", "Articulators (issue 45",
+               "Vowels beside the consonants (issue 45")
 
 
 def make(*args, timeout=1200):
