@@ -102,30 +102,29 @@ def glide_target(sym: str, g: Phoneme, inv: Inventory, lips, tongue_of: TongueOf
 
 
 def _parts(sym: str, p: Phoneme, inv: Inventory, lips, beside=(), tongue_of: TongueOf | None = None
-           ) -> list[tuple[dict | None, float]]:
-    """(target or None (hold the tongue), share of the duration) of each part of a phoneme (``beside``: a
-    vowel's neighbouring consonants)."""
+           ) -> list[tuple[dict | None, float, bool]]:
+    """(target or None (hold the tongue), share of the duration, whether it is a glide) of each part of a phoneme
+    (``beside``: a vowel's neighbouring consonants)."""
     if p.manner == "vowel":
-        return [(vowel_target(sym, p, inv, beside), 1.0)]
+        return [(vowel_target(sym, p, inv, beside), 1.0, False)]
     if p.place in TONGUELESS:
-        tongue = None
         if p.palatalized:  # the tongue body takes the palatal glide's place during the lips' or glottis' gesture
-            y = inv.phonemes["y"]
-            tongue = glide_target(f"{sym}_y", _colouring(inv), inv, lips)
-        return [(tongue, 1.0)]
+            return [(glide_target(f"{sym}_y", _colouring(inv), inv, lips), 1.0, True)]
+        return [(None, 1.0, False)]
+    if p.manner == "approximant":
+        return [(glide_target(sym, p, inv, lips, tongue_of), 1.0, True)]
     closure = p.manner in ("stop", "nasal", "tap", "affricate")
     shut = p.model_copy(update={"place": p.closure_place}) if p.closure_place is not None else p
-    first = (glide_target(sym, p, inv, lips, tongue_of) if p.manner == "approximant" else
-             constriction_target(sym, shut, inv, 0.0 if closure else p.channel_cm2, lips))
-    out = [(first, 1.0)]
+    first = constriction_target(sym, shut, inv, 0.0 if closure else p.channel_cm2, lips)
+    out = [(first, 1.0, False)]
     if p.manner == "affricate":
         share = inv.realisation.affricate_closure_share
-        out = [(first, share), (constriction_target(sym, p, inv, p.channel_cm2, lips, "_release"), 1 - share)]
+        out = [(first, share, False),
+               (constriction_target(sym, p, inv, p.channel_cm2, lips, "_release"), 1 - share, False)]
     if p.palatalized:
-        y = inv.phonemes["y"]
         share = inv.realisation.palatal_glide_share
-        out = [(t, s * (1 - share)) for t, s in out] + [
-            (glide_target(f"{sym}_y", _colouring(inv), inv, lips), share)]
+        out = [(t, s * (1 - share), g) for t, s, g in out] + [
+            (glide_target(f"{sym}_y", _colouring(inv), inv, lips), share, True)]
     return out
 
 
@@ -185,10 +184,10 @@ def realise(u: Utterance, inv: Inventory, default_lips: tuple[float, float], ton
         closing = voiced and p.manner in ("stop", "affricate", "tap") and p.velum_port_cm2 == 0 and sym not in ("N", "Q")
         expand = inv.realisation.voiced_stop_expansion_cm3_s if closing else None
         beside = [_neighbour(symbols, k, d, inv) for d in (-1, 1)] if p.manner == "vowel" else []
-        for n, (target, share) in enumerate(_parts(sym, p, inv, lips, beside, tongue_of)):
+        for n, (target, share, glide) in enumerate(_parts(sym, p, inv, lips, beside, tongue_of)):
             common = dict(duration_ms=seg.duration_ms * share, voiced=voiced, glottis_cm2=glottis,
                           label=sym if n == 0 else None, continues=n > 0, cavity_expansion_cm3_s=expand)
-            if target is not None and _is_glide(target, inv):  # a glide undershoots in a short interval: no press
+            if glide:  # a glide undershoots in a short interval: the timing does not press it
                 common["press"] = 1.0
             segments.append(Segment(target=target, **common) if target is not None else Segment(hold=True, **common))
         if p.lips == "closed" or (p.place == "bilabial" and p.manner == "fricative"):
@@ -228,14 +227,6 @@ def _colouring(inv: Inventory) -> Phoneme:
     """A palatalized consonant's glide: /y/'s place at the wider ``palatal_glide_cm2``, no vowel's tongue (a
     secondary articulation in a short part)."""
     return inv.phonemes["y"].model_copy(update={"channel_cm2": inv.realisation.palatal_glide_cm2, "like": None})
-
-
-def _is_glide(target: dict, inv: Inventory) -> bool:
-    """Whether a target is a glide's narrowing (a glide's own, or a palatalized consonant's glide)."""
-    c = target.get("constriction")
-    glides = [p for p in inv.phonemes.values() if p.manner == "approximant"] + [_colouring(inv)]
-    return c is not None and any(c["area_cm2"] == p.channel_cm2 and c["place"] == inv.places.get(p.place)
-                                 for p in glides)
 
 
 def _tube(lips, default_lips: tuple[float, float]) -> tuple[float, float]:

@@ -10,7 +10,7 @@ place read frame by frame, and the leads and presses moved by what was measured:
   ``LEAD_STEP_MS`` more and holds its own next part's switch (an affricate's release) back as much;
 * a channel never open to its area (an affricate's release after its closure) leads more and presses softer;
 * one released before its end (or, never made, narrowest before its end) delays the next segment's switch by
-  as much.
+  as much;
 * one made more than ``EARLY_MS`` before its start leads less by as much, less ``WINDOW_MS`` (a tap between
   high vowels, whose tongue is near the ridge already);
 * one still held more than ``HELD_MS`` after its end brings the next segment's switch forward by as long
@@ -189,7 +189,7 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
             best = (score, r, tried, late, early, held, traj)
         if not changed or score == 0.0:
             break
-    score, at, (leads, press), late, early, held, traj = best
+    _, _, (leads, press), late, early, held, traj = best
     return _with(u, leads, press), Timing(leads_ms=leads.tolist(), press=press.tolist(), rounds=r + 1,
                                           onset_late_ms=late, released_early_ms=early, held_late_ms=held,
                                           trajectory=traj)
