@@ -109,26 +109,33 @@ def utterance_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row
     return rows, lines + [""] + table + [""] + made + [""] + heard + [""] + pictures + [""]
 
 
-def vowel_class_table(records) -> tuple[list[str], list[Row]]:
-    """The vowels beside the consonants spoken through the inventory: each one's F1 / F2 (the formant tracks,
-    over its middle half) and the nearest of the five male Japanese means in Bark (speech/vowel_class.py, held to
-    Praat in the tests); one row for how many sound as intended."""
-    from ..speech.inventory import load_inventory
+def spoken_phones(records, manners: dict[str, str]):
+    """(path, record, phone intervals) of each record with a TextGrid that holds a consonant of the inventory."""
     from ..speech.textgrid import read_phones
-    from ..speech.vowel_class import heard_vowels
 
-    inv = load_inventory()
-    means = {v: tuple(p.formants_hz[:2]) for v, p in inv.phonemes.items() if p.manner == "vowel"}
-    out = ["The vowels beside the consonants, heard as the nearest of the five male Japanese means (Bark; F1 / F2 "
-           "from the formant tracks over each vowel's middle half):", ""]
-    ok = total = 0
     for path, rec in records:
         tg = path.with_suffix(".TextGrid")
         if not tg.is_file():
             continue
         iv = read_phones(tg)
-        if not any(inv.phonemes[lab].manner != "vowel" for _, _, lab in iv if lab in inv.phonemes):
-            continue
+        if any(manners.get(lab) not in (None, "vowel") for _, _, lab in iv):
+            yield path, rec, iv
+
+
+def vowel_class_table(records) -> tuple[list[str], list[Row]]:
+    """The vowels beside the consonants spoken through the inventory: each one's F1 / F2 (the formant tracks,
+    over its middle half) and the nearest of the five male Japanese means in Bark (speech/vowel_class.py, held to
+    Praat in the tests); one row for how many sound as intended."""
+    from ..speech.inventory import load_inventory
+    from ..speech.vowel_class import heard_vowels
+
+    inv = load_inventory()
+    means = {v: tuple(p.formants_hz[:2]) for v, p in inv.phonemes.items() if p.manner == "vowel"}
+    manners = {k: p.manner for k, p in inv.phonemes.items()}
+    out = ["The vowels beside the consonants, heard as the nearest of the five male Japanese means (Bark; F1 / F2 "
+           "from the formant tracks over each vowel's middle half):", ""]
+    ok = total = 0
+    for path, rec, iv in spoken_phones(records, manners):
         found = heard_vowels(iv, rec.time_s, rec.formants_hz, means)
         ok, total = ok + sum(h["ok"] for h in found), total + len(found)
         wrong = [f"/{h['label']}/ at {h['start_s']:.2f} s heard /{h['heard']}/ ({h['f1_hz']:.0f} / {h['f2_hz']:.0f} Hz)"
@@ -150,17 +157,13 @@ def articulator_table(records) -> tuple[list[str], list[Row]]:
     made it; one row for how many did."""
     from ..speech.articulation import LIMIT_CM, articulators
     from ..speech.inventory import load_inventory
-    from ..speech.textgrid import read_phones
 
     manners = {k: p.manner for k, p in load_inventory().phonemes.items()}
     out = [f"Which articulator made each consonant (at its narrowest frame, against the vowels beside it; the tip's "
            f"consonants keep the dorsum within {LIMIT_CM} cm, the dorsum's keep the tip from rising more):", ""]
     done = total = 0
-    for path, rec in records:
-        tg = path.with_suffix(".TextGrid")
-        if not tg.is_file():
-            continue
-        for m in articulators(rec, read_phones(tg), manners):
+    for path, rec, iv in spoken_phones(records, manners):
+        for m in articulators(rec, iv, manners):
             done, total = done + m["ok"], total + 1
             out.append(f"* /{rec.attrs.get('name', path.stem)}/ {m['symbol']} (the {m['by']}'s) at {m['at_s']:.3f} s: "
                        f"dorsum {m['dorsum_cm']:.2f} cm from the vowels', tip {m['tip_rise_cm']:+.2f} cm; "
@@ -184,7 +187,6 @@ def landmark_table(records) -> tuple[list[str], list[Row]]:
     from ..io.wav import read_wav
     from ..speech.inventory import load_inventory
     from ..speech.landmarks import consonants
-    from ..speech.textgrid import read_phones
 
     manners = {k: p.manner for k, p in load_inventory().phonemes.items()}
     out = ["Each consonant's acoustic landmarks (dB against the vowels beside it; voicing as a share of frames; "
@@ -194,13 +196,7 @@ def landmark_table(records) -> tuple[list[str], list[Row]]:
              "band_3_8k_db": "3-8 kHz {} dB", "centroid_hz": "centroid {} Hz", "dip_db": "dip {} dB",
              "f2_hz": "F2 {} Hz"}
     passed = total = 0
-    for path, rec in records:
-        tg = path.with_suffix(".TextGrid")
-        if not tg.is_file():
-            continue
-        iv = read_phones(tg)
-        if not any(manners.get(lab) not in (None, "vowel") for _, _, lab in iv):
-            continue
+    for path, rec, iv in spoken_phones(records, manners):
         y, rate = read_wav(path.with_suffix(".wav"))
         for m in consonants(y, rate, iv, manners, (rec.time_s, rec.formants_hz)):
             ok = all(m["checks"].values())

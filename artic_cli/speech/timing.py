@@ -86,11 +86,17 @@ def place_areas(u: Utterance, p: Plan, cfg: Config, model: Model, rest, goals: l
     return traj, {g.segment: place_area(tracts.af.area_cm2, region, g.place) for g in goals}
 
 
+def made(area: np.ndarray, reach: float, floor: float = 0.0) -> np.ndarray:
+    """Per frame, whether the constriction is made: its area at most ``reach`` and, for a channel (``floor`` > 0),
+    above ``floor``."""
+    return (area <= reach) & (area > floor) if floor > 0 else area <= reach
+
+
 def onset_and_release(t: np.ndarray, area: np.ndarray, reach: float, start: float, end: float, floor: float = 0.0):
     """(ms after ``start`` the constriction is first made (its area at most ``reach``, above ``floor`` when that
     is not 0), NaN if never before ``end``; ms before ``end`` it leaves that range again, 0 if it holds; when never
     made, ms before ``end`` the area was narrowest: where it turned back)."""
-    ok = (area <= reach) & ((area > floor) if floor > 0 else True)
+    ok = made(area, reach, floor)
     window = (t >= start - WINDOW_MS / 1e3) & (t < end)
     hit = np.flatnonzero(ok & window)
     if not len(hit):
@@ -106,7 +112,7 @@ def onset_and_release(t: np.ndarray, area: np.ndarray, reach: float, start: floa
 
 def held_after(t: np.ndarray, area: np.ndarray, reach: float, end: float, floor: float = 0.0) -> float:
     """How long (ms) a constriction made at ``end`` stays made after it (0 if it is open at its end)."""
-    ok = (area <= reach) & ((area > floor) if floor > 0 else True)
+    ok = made(area, reach, floor)
     at = np.flatnonzero(t >= end - 1e-9)
     if not len(at) or not ok[max(at[0] - 1, 0)]:
         return 0.0
@@ -117,7 +123,7 @@ def held_after(t: np.ndarray, area: np.ndarray, reach: float, end: float, floor:
 
 def made_before(t: np.ndarray, area: np.ndarray, reach: float, start: float, floor: float = 0.0) -> float:
     """How long (ms) before ``start`` a constriction made at its start was first made (0 if not made then)."""
-    ok = (area <= reach) & ((area > floor) if floor > 0 else True)
+    ok = made(area, reach, floor)
     at = np.flatnonzero(t <= start + 1e-9)
     if not len(at) or not ok[at[-1]]:
         return 0.0
