@@ -108,6 +108,12 @@ class EPFormants:
         self.cache: dict = {}
         self.whole = None  # the maps with the EPs' shapes, read once when other lips or ports need them
 
+    def whole_maps(self):
+        """The maps with the EPs' shapes (read once, kept)."""
+        if self.whole is None:
+            self.whole = self.load_maps()
+        return self.whole
+
     def areas(self, jaw: str) -> dict:
         """Every EP's area function at a jaw position with the config's lips and port: net key -> (*grid, S)
         cm^2 (the stored acoustic maps', else computed from the EPs' shapes; kept)."""
@@ -119,9 +125,7 @@ class EPFormants:
             if held is not None and jaw in held.jaws:
                 self.cache[key] = {k: n.area_cm2 for k, n in held.jaws[jaw].items()}
             else:
-                if self.whole is None:
-                    self.whole = self.load_maps()
-                nets = acoustic_maps(self.cfg, self.mesh, self.whole, jaws=[jaw], bandwidths=False).jaws[jaw]
+                nets = acoustic_maps(self.cfg, self.mesh, self.whole_maps(), jaws=[jaw], bandwidths=False).jaws[jaw]
                 self.cache[key] = {k: n.area_cm2 for k, n in nets.items()}
         return self.cache[key]
 
@@ -139,8 +143,6 @@ class EPFormants:
             return {k: n.formants_hz for k, n in stored.jaws[jaw].items()}
         if held is not None:
             return held
-        if self.whole is None:
-            self.whole = self.load_maps()
-        nets = acoustic_maps(self.cfg, self.mesh, self.whole, jaws=[jaw], overrides={
+        nets = acoustic_maps(self.cfg, self.mesh, self.whole_maps(), jaws=[jaw], overrides={
             "lip_area_cm2": area, "lip_length_cm": length, "velum_port_cm2": port}, bandwidths=False).jaws[jaw]
         return {k: n.formants_hz for k, n in nets.items()}

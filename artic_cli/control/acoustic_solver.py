@@ -6,7 +6,8 @@ Bark scale (Traunmueller 1990), a perceptual distance: along single-muscle vecto
 inside each co-contraction level of the three-muscle groups (bilinear in each cell, inverted exactly).  A
 candidate counts when F1 and F2 are each within the tolerance (per cent of the target); F3, when given, is
 approached.  Among those the cheapest wins: forces^2, the indecisive features' distances (as the spatial
-solver) and F3's Bark error.  Formants are interpolated linearly between EPs: a refinement by simulation
+solver), F3's Bark error and, for a ``tongue_highest``, how far the tongue's highest point (interpolated as
+the formants are) falls short of its class.  Formants are interpolated linearly between EPs: a refinement by simulation
 (:func:`..verify.refine_formants`) corrects what that misses.
 """
 
@@ -21,6 +22,7 @@ from .solver import (Candidate, TargetSpec, bilinear, mapped_nets, polyline_near
                      indecisive_cost, invert_cells)
 
 FormantNets = dict  # "single/SG" | "pair/A+B" | "group/I+A+B" -> (*grid, K) formants of the net's EPs, Hz
+TopNets = tuple  # (net key -> (*grid, 2) the EPs' tongue highest points, the model's rest's (2,)), cm
 
 
 def within(target: TargetSpec, formants_hz, share: float = 1.0) -> bool:
@@ -39,16 +41,25 @@ def errors_pct(target: TargetSpec, formants_hz) -> list[float]:
 class AcousticProblem:
     """An acoustic target on the maps (and formants) of one jaw position."""
 
-    def __init__(self, jm: JawMaps, target: TargetSpec, formants: FormantNets, reach: float = 1.0):
-        self.jm, self.t, self.formants = jm, target, formants
+    def __init__(self, jm: JawMaps, target: TargetSpec, formants: FormantNets, reach: float = 1.0,
+                 tops: TopNets | None = None):
+        self.jm, self.t = jm, target
+        self.k = next(iter(formants.values())).shape[-1] if formants else 0  # formants per EP
+        self.rest_top = None
+        if target.tongue_highest is not None and tops is not None:  # the highest points ride with the formants
+            nets, self.rest_top = tops
+            formants = {k: np.concatenate([f, nets[k]], axis=-1) for k, f in formants.items() if k in nets}
+        self.formants = formants
         goal = np.asarray(target.acoustic.formants_hz, dtype=float)
         self.goal_hz = goal
         self.goal = hz_to_bark(goal[:2])
         box = hz_to_bark(goal[:2] * (1 + target.acoustic.tolerance)) - self.goal  # the tolerance in Bark
         self.reach = reach * float(np.hypot(*box))  # cells and vectors searched within this Bark distance
 
-    def cost(self, forces: dict[str, float], pred: np.ndarray, f_hz: np.ndarray) -> float:
+    def cost(self, forces: dict[str, float], pred: np.ndarray, f_hz: np.ndarray, top: np.ndarray | None) -> float:
         c = indecisive_cost(self.t, forces, pred)
+        if top is not None:
+            c += self.t.distance_weight * float(np.sum(self.t.tongue_highest.shortfall_cm(top, self.rest_top) ** 2))
         if len(self.goal_hz) > 2 and np.isfinite(f_hz[2]):
             c += self.t.acoustic.f3_weight * self.t.distance_weight * float(hz_to_bark(f_hz[2]) -
                                                                             hz_to_bark(self.goal_hz[2])) ** 2
@@ -56,11 +67,14 @@ class AcousticProblem:
 
     def _candidate(self, family, name, forces, pred, f_hz, detail) -> Candidate:
         forces = {k: float(v) for k, v in forces.items() if v > 1e-12}
+        f_hz, top = f_hz[: self.k], (f_hz[self.k:] if self.rest_top is not None else None)
         err = float(np.linalg.norm(hz_to_bark(f_hz[:2]) - self.goal))
         detail = dict(detail, formants_hz=[float(v) for v in f_hz])
+        if top is not None:
+            detail["tongue_top_cm"] = [float(v) for v in top]
         return Candidate(family=family, name=name, forces=forces,
                          predicted={cp: [float(pred[k, 0]), float(pred[k, 1])] for k, cp in enumerate(("tip", "dorsum"))},
-                         crucial_error=err, cost=self.cost(forces, pred, f_hz), detail=detail)
+                         crucial_error=err, cost=self.cost(forces, pred, f_hz, top), detail=detail)
 
     def singles(self) -> list[Candidate]:
         out = []
@@ -153,10 +167,12 @@ class AcousticProblem:
         return best
 
 
-def solve_acoustic_on(jm: JawMaps, target: TargetSpec, formants: FormantNets, widen: bool = False) -> list[Candidate]:
-    """Every candidate whose interpolated F1 and F2 are within tolerance, cheapest first.  With ``widen`` (a
-    refinement follows) and none within, the ones within twice the tolerance's Bark distance, nearest first."""
-    p = AcousticProblem(jm, target, formants, reach=2.0 if widen else 1.0)
+def solve_acoustic_on(jm: JawMaps, target: TargetSpec, formants: FormantNets, widen: bool = False,
+                      tops: TopNets | None = None) -> list[Candidate]:
+    """Every candidate whose interpolated F1 and F2 are within tolerance, cheapest first (``tops``: the EPs'
+    tongue highest points, for a target's ``tongue_highest``).  With ``widen`` (a refinement follows) and none
+    within, the ones within twice the tolerance's Bark distance, nearest first."""
+    p = AcousticProblem(jm, target, formants, reach=2.0 if widen else 1.0, tops=tops)
     found = p.singles() + p.nets()
     cands = sorted([c for c in found if within(target, c.detail["formants_hz"])], key=lambda c: c.cost)
     if not cands and widen:
@@ -173,8 +189,9 @@ def solve_acoustic_on(jm: JawMaps, target: TargetSpec, formants: FormantNets, wi
     return cands
 
 
-def nearest_candidate(jm: JawMaps, target: TargetSpec, formants: FormantNets) -> Candidate | None:
+def nearest_candidate(jm: JawMaps, target: TargetSpec, formants: FormantNets,
+                      tops: TopNets | None = None) -> Candidate | None:
     """The force set whose interpolated formants come nearest the target (in Bark), however far."""
-    p = AcousticProblem(jm, target, formants, reach=np.inf)
+    p = AcousticProblem(jm, target, formants, reach=np.inf, tops=tops)
     found = p.singles() + p.nets()
     return min(found, key=lambda c: (c.crucial_error, c.cost)) if found else None

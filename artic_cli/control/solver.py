@@ -89,15 +89,38 @@ class Constriction(Strict):
         return bool(np.isfinite(area_cm2) and abs(area_cm2 - self.area_cm2) <= self.tolerance_cm2)
 
 
+TongueClass = Literal["high-front", "high-central", "high-back", "mid-front", "mid-central", "mid-back", "low-front",
+                      "low-central", "low-back"]
+
+
+class TongueHighest(Strict):
+    """Where an acoustic target's tongue is highest, against the model's rest tongue's highest point: high at
+    least ``margin_cm`` above it, low as far below, front / back as far before / behind it; mid and central ask
+    nothing.  Each cm short costs as an indecisive feature's cm (``distance_weight``)."""
+
+    tongue: TongueClass
+    margin_cm: Annotated[float, Field(ge=0, le=2, allow_inf_nan=False)] = 0.15
+
+    def shortfall_cm(self, top: np.ndarray, rest_top: np.ndarray) -> np.ndarray:
+        """(..., 2) how far (x, y cm, >= 0) highest points ``top`` (..., 2) fall short of the class."""
+        height, frontness = self.tongue.split("-")
+        d = np.asarray(top, float) - np.asarray(rest_top, float)
+        sx = {"front": 1.0, "back": -1.0}.get(frontness, 0.0)
+        sy = {"high": 1.0, "low": -1.0}.get(height, 0.0)
+        return np.stack([np.where(sx != 0, np.maximum(self.margin_cm - sx * d[..., 0], 0.0), 0.0),
+                         np.where(sy != 0, np.maximum(self.margin_cm - sy * d[..., 1], 0.0), 0.0)], axis=-1)
+
+
 class Lips(Strict):
     area_cm2: Annotated[float, Field(gt=0, le=10, allow_inf_nan=False)]
     length_cm: Annotated[float, Field(gt=0, le=4, allow_inf_nan=False)]
 
 
 # lip tubes by name (VocalTractLab's JD3 vowels, the sections its lips make: /o/ 1.53 cm, 0.40-0.82 cm^2;
-# /u/ 1.91 cm, 0.33-0.41 cm^2; /e/ /i/ 0.53-0.55 cm, 1.2-2.5 cm^2; /a/ 0.54 cm, 2.7-2.84 cm^2); "neutral" is
+# /u/ 1.91 cm, 0.33-0.41 cm^2; /e/ /i/ 0.53-0.55 cm, 1.2-2.5 cm^2; /a/ 0.54 cm, 2.7-2.84 cm^2); "compressed"
+# is Japanese /u/'s, narrow without protrusion (the default length; docs/inventory.md, "Vowels"); "neutral" is
 # the config's default
-LIP_SHAPES = {"rounded": Lips(area_cm2=0.6, length_cm=1.5), "compressed": Lips(area_cm2=0.37, length_cm=1.9),
+LIP_SHAPES = {"rounded": Lips(area_cm2=0.6, length_cm=1.5), "compressed": Lips(area_cm2=0.5, length_cm=1.0),
               "spread": Lips(area_cm2=2.5, length_cm=0.55), "open": Lips(area_cm2=2.8, length_cm=0.55)}
 
 
@@ -108,6 +131,7 @@ class TargetSpec(Strict):
     acoustic: AcousticGoal | None = None  # ... formants (a vowel), or ...
     constriction: Constriction | None = None  # ... the area at a place of the tract: one of the three
     indecisive: list[Indecisive] = []
+    tongue_highest: TongueHighest | None = None  # acoustic targets: where the tongue is highest (a vowel's class)
     lips: Lips | Literal["neutral", "rounded", "compressed", "spread", "open"] | None = None  # acoustic targets only
     velum_port_cm2: Annotated[float, Field(ge=0, le=5, allow_inf_nan=False)] | None = None
     force_weight: NonNegative = 1.0  # per N^2
@@ -135,6 +159,9 @@ def parse_target(data: object, source: str = "<target>", max_force_n: float = DE
     if t.crucial is None and t.jaw.forces_n is None:
         raise ArticError(f"{source}: key 'jaw': an acoustic or constriction target needs jaw.forces_n of a mapped "
                          "jaw position (the acoustic maps hold the EPs' shapes only there)")
+    if t.acoustic is None and t.tongue_highest is not None:
+        raise ArticError(f"{source}: key 'tongue_highest' belongs to acoustic targets (a vowel's formants); remove "
+                         "it or give 'acoustic'")
     if t.crucial is not None and (t.lips is not None or t.velum_port_cm2 is not None):
         raise ArticError(f"{source}: keys 'lips' and 'velum_port_cm2' belong to acoustic targets; remove them or "
                          "give 'acoustic' instead of 'crucial'")

@@ -42,6 +42,7 @@ class Context:
     acoustic_sha256: str | None = None  # the acoustic maps' content, when they gave the formants
     areas: Callable[[str], dict] | None = None  # constriction targets: jaw -> net key -> (*grid, S) areas, cm^2
     places: tuple | None = None  # (S,) each section's place index and the places' names
+    tops: Callable[[str], dict] | None = None  # jaw -> net key -> (*grid, 2) the EPs' tongue highest points, cm
 
 
 def jaw_maps(ctx: Context, target: TargetSpec) -> tuple[JawMaps, dict[str, float], float, str]:
@@ -116,7 +117,10 @@ def _formant_doc(target: TargetSpec, f_hz, extra: dict | None = None) -> dict:
 def _voiced_candidate(c: Candidate) -> dict:
     d = _cand(c)
     d.pop("crucial_error_cm")
-    return dict(d, predicted_formants_hz=[_num(v) for v in c.detail["formants_hz"]], bark_error=_num(c.crucial_error))
+    d = dict(d, predicted_formants_hz=[_num(v) for v in c.detail["formants_hz"]], bark_error=_num(c.crucial_error))
+    if "tongue_top_cm" in c.detail:
+        d["predicted_tongue_top_cm"] = [_num(v) for v in c.detail["tongue_top_cm"]]
+    return d
 
 
 def solve_acoustic(ctx: Context, target: TargetSpec, voicer=None, verify: bool = False, refine: bool = False,
@@ -138,10 +142,15 @@ def solve_acoustic(ctx: Context, target: TargetSpec, voicer=None, verify: bool =
             "acoustic": {"formants_hz": [float(v) for v in target.acoustic.formants_hz],
                          "tolerance_pct": target.acoustic.tolerance_pct},
             "lips": {"area_cm2": _num(lips[0]), "length_cm": _num(lips[1])}, "velum_port_cm2": _num(port)}
+    tops = None
+    if target.tongue_highest is not None and ctx.tops is not None:
+        tops = (ctx.tops(jaw), ctx.tops.rest)
+        head["tongue_highest"] = {"tongue": target.tongue_highest.tongue, "margin_cm": target.tongue_highest.margin_cm,
+                                  "rest_top_cm": [_num(v) for v in tops[1]]}
     try:
-        cands = solve_acoustic_on(jm, target, formants, widen=refine)
+        cands = solve_acoustic_on(jm, target, formants, widen=refine, tops=tops)
     except UnreachableTarget as err:  # the answer is still the nearest force set the maps know
-        near = nearest_candidate(jm, target, formants)
+        near = nearest_candidate(jm, target, formants, tops=tops)
         if near is not None:
             err.answer = dict(head, nearest=_voiced_candidate(near))
             if (verify or refine) and voicer is not None:  # ... and what it really gives

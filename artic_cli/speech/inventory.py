@@ -10,7 +10,7 @@ from typing import Annotated, Literal
 from pydantic import BeforeValidator, Field, model_validator
 
 from ..config import read_yaml
-from ..control.solver import JawSpec, Lips
+from ..control.solver import JawSpec, Lips, TongueClass
 from ..errors import ArticError
 from ..validation import DurationMs, FormantHz, Strict, increasing, parse
 
@@ -20,8 +20,7 @@ SYMBOLS = ("a i u e o k g s z t d n h b p m y r w f sh ch ts j ky gy ny hy my ry
 
 Manner = Literal["vowel", "stop", "nasal", "fricative", "affricate", "tap", "approximant", "moraic_nasal", "geminate"]
 Place = Literal["bilabial", "alveolar", "postalveolar", "palatal", "velar", "glottal"]
-Height = Literal["high-front", "high-central", "high-back", "mid-front", "mid-central", "mid-back", "low-front",
-                 "low-central", "low-back"]
+Height = TongueClass  # where a vowel's tongue is highest: high / mid / low x front / central / back
 Area = Annotated[float, Field(gt=0, le=2, allow_inf_nan=False)]
 JAW_NAME = re.compile(r"^(rest|(JO|JC)_(\d+(\.\d+)?))$")
 
@@ -93,6 +92,9 @@ class Realisation(Strict):
 
     vowel_tolerance_pct: Annotated[list[Annotated[float, Field(gt=0, le=50)]], Field(min_length=2, max_length=2)] \
         = [10.0, 7.0]  # F1's and F2's
+    # a vowel's tongue highest at least this far above / below / before / behind the rest tongue's, as its
+    # tongue_highest names (control/solver.py, TongueHighest)
+    tongue_margin_cm: Annotated[float, Field(ge=0, le=2, allow_inf_nan=False)] = 0.15
     closure_tolerance_cm2: Annotated[float, Field(gt=0, le=0.1, allow_inf_nan=False)] = 0.01
     channel_tolerance: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = 0.3  # a share of the channel
     affricate_closure_share: Share = 0.5  # of an affricate's duration, the rest its channel

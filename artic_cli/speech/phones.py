@@ -58,6 +58,7 @@ def vowel_target(sym: str, p: Phoneme, inv: Inventory, beside: list[Phoneme] = (
     name = f"{sym}_vowel" if jaw == p.jaw else f"{sym}_vowel_jaw_{openness(jaw):g}".replace(".", "p").replace("-", "m")
     return {"name": name, "jaw": jaw.model_dump(exclude_none=True),
             "acoustic": {"formants_hz": list(p.formants_hz), "tolerance_pct": list(inv.realisation.vowel_tolerance_pct)},
+            "tongue_highest": {"tongue": p.tongue_highest, "margin_cm": inv.realisation.tongue_margin_cm},
             **({"lips": _dump(_lips(p))} if _lips(p) is not None else {})}
 
 

@@ -9,6 +9,7 @@ from ..config import load_config
 from ..control.acoustic_map import EPFormants
 from ..control.solver import TargetSpec
 from ..control.targets import Context, load_target, solve
+from ..control.tongue_tops import TongueTops
 from ..control.verify import Simulator
 from ..control.voicing import Voicer
 from ..errors import ArticError, UnreachableTarget
@@ -63,6 +64,7 @@ def add_formants(ctx: Context, maps: Path | str, mesh: Path | str, config: Path 
     oracle = EPFormants(cfg, m.mesh, lambda: epmap_stage.read(maps), stored, read_areas)
     ctx.formants, ctx.lips_default, ctx.port_default = oracle, oracle.defaults[:2], oracle.defaults[2]
     ctx.areas, ctx.places = oracle.areas, section_places(speaker_tract(cfg))
+    ctx.tops = TongueTops(m.mesh, oracle.whole_maps)
     return ctx
 
 

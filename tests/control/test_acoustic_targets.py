@@ -31,6 +31,11 @@ def _acoustic(formants, tol=5.0, **extra):
     ({"acoustic": {"formants_hz": [500, 1500]}, "lips": {"area_cm2": -1, "length_cm": 1}}, "lips"),
     ({"acoustic": {"formants_hz": [500, 1500]}, "jaw": {"opening_cm": -0.3}}, "mapped jaw position"),
     ({"crucial": {"point": "tip", "at_cm": [0, 0]}, "lips": "rounded"}, "belong to acoustic targets"),
+    ({"crucial": {"point": "tip", "at_cm": [0, 0]}, "tongue_highest": {"tongue": "high-back"}},
+     "'tongue_highest' belongs to acoustic targets"),
+    ({"acoustic": {"formants_hz": [500, 1500]}, "tongue_highest": {"tongue": "up-back"}}, "tongue_highest.tongue"),
+    ({"acoustic": {"formants_hz": [500, 1500]}, "tongue_highest": {"tongue": "high-back", "margin_cm": -1}},
+     "tongue_highest.margin_cm"),
 ])
 def test_bad_acoustic_targets_are_refused_naming_the_key(data, needle):
     data = {"name": "v", "jaw": {"forces_n": {}}, **data}
@@ -50,6 +55,43 @@ def _linear_net():
     net = Net(muscles=("A", "B"), levels=(lv, lv), x=x, converged=np.ones((4, 4), bool), drift_cm=np.zeros((4, 4)))
     jm = JawMaps(forces={}, rest=x[0, 0], single={}, pair={"A+B": net})
     return jm, {"pair/A+B": f}
+
+
+def _two_vectors():
+    """Two single vectors that both pass 500 / 1500 Hz: A at 1 N (cheaper), B at 2 N, whose tongue top rises and
+    moves back with its force (A's stays at the rest's)."""
+    lv = np.array([0.0, 1.0, 2.0, 4.0])
+    x = np.zeros((4, 3, 3))
+    nets = {m: Net(muscles=(m,), levels=(lv,), x=x, converged=np.ones(4, bool), drift_cm=np.zeros(4)) for m in "AB"}
+    fa = np.stack([400 + 100 * lv, 1400 + 100 * lv, 2500 + 0 * lv, 3500 + 0 * lv], axis=-1)
+    fb = np.stack([400 + 50 * lv, 1400 + 50 * lv, 2500 + 0 * lv, 3500 + 0 * lv], axis=-1)
+    rest = np.array([-3.5, 1.3])
+    tops = {"single/A": np.tile(rest, (4, 1)), "single/B": rest + np.outer(lv, [-0.15, 0.15])}
+    return JawMaps(forces={}, rest=x[0], single=nets), {"single/A": fa, "single/B": fb}, (tops, rest)
+
+
+def test_a_tongue_class_chooses_the_force_set_whose_tongue_is_highest_where_it_names():
+    jm, formants, tops = _two_vectors()
+    plain = solve_acoustic_on(jm, _acoustic((500, 1500)), formants, tops=tops)
+    assert plain[0].forces == pytest.approx({"A": 1.0})  # the cheapest, no class asked
+    t = _acoustic((500, 1500), tongue_highest={"tongue": "high-back", "margin_cm": 0.25})
+    best = solve_acoustic_on(jm, t, formants, tops=tops)[0]
+    assert best.forces == pytest.approx({"B": 2.0})
+    assert best.detail["tongue_top_cm"] == pytest.approx([-3.8, 1.6])
+    low = _acoustic((500, 1500), tongue_highest={"tongue": "low-front", "margin_cm": 0.25})
+    assert solve_acoustic_on(jm, low, formants, tops=tops)[0].forces == pytest.approx({"A": 1.0})  # B is worse
+
+
+def test_a_tongue_class_measures_its_shortfall_from_the_rest_tongue():
+    from artic_cli.control.solver import TongueHighest
+
+    rest = np.array([-3.5, 1.3])
+    hb = TongueHighest(tongue="high-back", margin_cm=0.2)
+    assert hb.shortfall_cm(np.array([-3.5, 1.3]), rest) == pytest.approx([0.2, 0.2])
+    assert hb.shortfall_cm(np.array([-3.8, 1.6]), rest) == pytest.approx([0.0, 0.0])
+    assert TongueHighest(tongue="low-front", margin_cm=0.2).shortfall_cm(np.array([-3.4, 1.2]), rest) \
+        == pytest.approx([0.1, 0.1])
+    assert TongueHighest(tongue="mid-central").shortfall_cm(np.array([-5.0, 3.0]), rest) == pytest.approx([0, 0])
 
 
 def test_formants_inside_a_net_give_the_forces_that_make_them():

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from artic_cli.speech.tongue_height import highest_point, misordered
+from artic_cli.speech.tongue_height import misordered
+from artic_cli.tract.tongue_top import highest_point
 
 NAMED = {"a": "low-back", "i": "high-front", "u": "high-back", "e": "mid-front", "o": "mid-back"}
 

@@ -269,7 +269,8 @@ def test_the_pipelines_vowels_hold_the_tongue_highest_where_the_inventory_says(b
     from artic_cli.config import load_config
     from artic_cli.control.verify import Simulator
     from artic_cli.speech.inventory import load_inventory
-    from artic_cli.speech.tongue_height import highest_point, misordered
+    from artic_cli.speech.tongue_height import misordered
+    from artic_cli.tract.tongue_top import highest_point
     from artic_cli.stages import mesh as mesh_stage
     from artic_cli.tract.shapes import surface_nodes
 
