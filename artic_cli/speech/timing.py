@@ -16,7 +16,8 @@ place read frame by frame, and the leads and presses moved by what was measured:
 * one still held more than ``HELD_MS`` after its end brings the next segment's switch forward by as long
   (a release on time: a stop's burst inside its interval, a voiced closure no longer than its voicing lasts).
 
-Leads keep the switches in order (``MIN_GAP_MS`` apart); a segment whose lead or press the utterance gives is
+A round whose simulation is not physical (an inverted brick) is never kept, and every press above 1 softens
+a step for the next.  Leads keep the switches in order (``MIN_GAP_MS`` apart); a segment whose lead or press the utterance gives is
 left as given.  The rounds stop when nothing moves or every constriction is on time; the round that missed
 the fewest ms of its constrictions' intervals is the one kept (the corrections of a closure and of the channel
 after it can swing), with what it measured.
@@ -31,6 +32,7 @@ import numpy as np
 from ..config import Config
 from ..control.solver import TargetSpec
 from ..mechanics.model import Model
+from ..mechanics.simulate import problems
 from ..tract.places import place_area, place_index, section_places
 from ..tract.speaker import speaker_tract
 from .plan import Plan
@@ -151,6 +153,10 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
     for r in range(rounds):
         trial = _with(u, leads, press)
         traj, areas = place_areas(trial, p, cfg, model, rest, goals)
+        if problems(traj, model.volume_constraint):  # pressed too hard: never kept, every press softer
+            if not soften(press, free_press):
+                break
+            continue
         t = traj.time
         late, early, held, soon = {}, {}, {}, {}
         tried = leads.copy(), press.copy()
@@ -195,6 +201,8 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
             best = (score, r, tried, late, early, held, traj)
         if not changed or score == 0.0:
             break
+    if best is None:  # no round was physical: the last, for the caller to refuse
+        return _with(u, leads, press), None
     _, _, (leads, press), late, early, held, traj = best
     return _with(u, leads, press), Timing(leads_ms=leads.tolist(), press=press.tolist(), rounds=r + 1,
                                           onset_late_ms=late, released_early_ms=early, held_late_ms=held,
@@ -221,6 +229,13 @@ def missed_ms(goals: list[Goal], late: dict, early: dict, starts: np.ndarray, en
                 share = min(max(gap, 0.0) / (0.5 * (g.floor_cm2 + g.reach_cm2)), 1.0)
         out += span * share
     return float(out)
+
+
+def soften(press: np.ndarray, free: list[bool]) -> bool:
+    """Every free press above 1 a step softer (not below 1); whether any moved."""
+    hard = np.array(free, bool) & (press > 1.0)
+    press[hard] = np.maximum(press[hard] / PRESS_STEP, 1.0)
+    return bool(hard.any())
 
 
 def _in_order(leads: np.ndarray, starts: np.ndarray, free: list[bool]) -> None:

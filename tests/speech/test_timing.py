@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from artic_cli.speech.timing import onset_and_release
+from artic_cli.speech.timing import onset_and_release, soften
 
 T = np.arange(0.0, 0.4, 0.005)
 
@@ -61,3 +61,12 @@ def test_a_closure_made_long_before_its_interval_is_measured_from_its_making():
     area = np.where((T >= 0.030) & (T < 0.150), 0.0, 0.5)  # shut from 30 ms, its interval starting at 100 ms
     assert made_before(T, area, 0.01, 0.100) == pytest.approx(70.0)
     assert made_before(T, np.where(T >= 0.120, 0.0, 0.5), 0.01, 0.100) == 0.0  # open at its start
+
+
+def test_an_unphysical_round_softens_every_free_press_above_one_a_step():
+    from artic_cli.speech.timing import PRESS_STEP
+
+    press = np.array([1.0, 1.75, 0.8, 1.1, 2.0])
+    assert soften(press, [True, True, True, True, False])
+    assert press.tolist() == pytest.approx([1.0, 1.75 / PRESS_STEP, 0.8, 1.0, 2.0])  # given presses kept
+    assert not soften(np.array([1.0, 0.9]), [True, True])  # nothing left to soften
