@@ -175,11 +175,11 @@ def test_the_acoustic_maps_hold_the_mapped_lip_tubes_formants_as_computed(small_
     tmp, cfg = small_maps
     acoustic_map(tmp / "maps.h5", mesh_file, cfg, tmp_path / "am.h5")
     held = read(tmp_path / "am.h5", formants_only=True)
-    assert set(held.lips) == {(4.0, 0.5), (2.5, 0.55), (1.0, 1.2), (0.37, 1.9)}
+    assert set(held.lips) == {(4.0, 0.5), (2.5, 0.55), (1.0, 1.2), (0.5, 1.0)}
     with_maps = add_formants(load_context(tmp / "maps.h5", None, mesh_file), tmp / "maps.h5", mesh_file, cfg,
                              tmp_path / "am.h5")
     computed = add_formants(load_context(tmp / "maps.h5", None, mesh_file), tmp / "maps.h5", mesh_file, cfg)
-    for lips in ((2.5, 0.55), (0.37, 1.9), (0.6, 1.5)):
+    for lips in ((2.5, 0.55), (0.5, 1.0), (0.6, 1.5)):
         a, b = with_maps.formants("rest", *lips, 0.0), computed.formants("rest", *lips, 0.0)
         assert set(a) == set(b) and len(a) == 5
         for key in a:

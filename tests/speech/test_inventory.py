@@ -21,7 +21,7 @@ def test_the_inventory_names_every_symbol_with_features_and_places_the_tract_has
     assert all(p[s].manner == "stop" for s in ("p", "b", "t", "d", "k", "g"))
     assert p["r"].manner == "tap" and p["r"].duration_ms <= 30
     # features, never muscle forces: a jaw is a mapped jaw position, read as the opener's or closer's force
-    assert p["a"].jaw.forces_n == {"JO": 6.0} and p["u"].jaw.forces_n == {}
+    assert p["a"].jaw.forces_n == {"JO": 6.0} and p["u"].jaw.forces_n == {"JO": 0.5}
     assert {k for e in p.values() if e.jaw is not None for k in (e.jaw.forces_n or {})} <= {"JO", "JC"}
 
 
