@@ -196,9 +196,12 @@ def landmark_table(records) -> tuple[list[str], list[Row]]:
              "band_3_8k_db": "3-8 kHz {} dB", "centroid_hz": "centroid {} Hz", "dip_db": "dip {} dB",
              "f2_hz": "F2 {} Hz"}
     passed = total = 0
+    centroids: dict[str, list[float]] = {"s": [], "sh": []}
     for path, rec, iv in spoken_phones(records, manners):
         y, rate = read_wav(path.with_suffix(".wav"))
         for m in consonants(y, rate, iv, manners, (rec.time_s, rec.formants_hz)):
+            if m["symbol"] in centroids and np.isfinite(m.get("centroid_hz", np.nan)):
+                centroids[m["symbol"]].append(float(m["centroid_hz"]))
             ok = all(m["checks"].values())
             passed, total = passed + ok, total + 1
             cells = []
@@ -214,7 +217,18 @@ def landmark_table(records) -> tuple[list[str], list[Row]]:
         return [], []
     row = Row("Consonant landmarks (issue 45's checks, every consonant spoken)", "every consonant passes its manner's "
               "checks (goal)", f"{passed} of {total} pass", verdict(passed == total, "every consonant's landmarks"))
-    return out, [row]
+    return out, [row] + centroid_rows(centroids)
+
+
+def centroid_rows(centroids: dict[str, list[float]]) -> list[Row]:
+    """Whether every /sh/'s 1-10 kHz centroid (Hz) lies below every /s/'s: the place heard in the noise ([ɕ]'s
+    longer front cavity rings lower); no row without both."""
+    if not (centroids.get("s") and centroids.get("sh")):
+        return []
+    said = lambda v: ", ".join(f"{x:.0f}" for x in v)  # noqa: E731
+    return [Row("Centroids of /sh/ below /s/'s (issue 45)", "every /sh/'s 1-10 kHz centroid below every /s/'s (goal)",
+                f"/sh/ {said(centroids['sh'])} Hz; /s/ {said(centroids['s'])} Hz",
+                verdict(max(centroids["sh"]) < min(centroids["s"]), "the place in the noise"))]
 
 
 def _goal_rows(name: str, m: dict, rec, y: np.ndarray, rate: int) -> list[Row]:
