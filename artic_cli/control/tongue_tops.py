@@ -15,7 +15,8 @@ from ..tract.tongue_top import highest_point, highest_points
 class TongueTops:
     def __init__(self, mesh, load_maps: Callable[[], object]):
         self.surface = surface_nodes(mesh)[0]
-        self.load_maps, self.maps, self.cache = load_maps, None, {}
+        self.load_maps, self.maps, self.cache = load_maps, None, {}  # cache: jaw position -> its nets' tops
+        self.rest_top: np.ndarray | None = None
 
     def _maps(self):
         if self.maps is None:
@@ -25,11 +26,11 @@ class TongueTops:
     @property
     def rest(self) -> np.ndarray:
         """(2,) the model's rest tongue's highest point (cm)."""
-        if "rest" not in self.cache:
+        if self.rest_top is None:
             m = self._maps()
             shape = m.model_rest if m.model_rest is not None else next(iter(m.jaws.values())).rest_shape
-            self.cache["rest"] = highest_point(np.asarray(shape)[self.surface, :2])
-        return self.cache["rest"]
+            self.rest_top = highest_point(np.asarray(shape)[self.surface, :2])
+        return self.rest_top
 
     def __call__(self, jaw: str) -> dict[str, np.ndarray]:
         if jaw not in self.cache:

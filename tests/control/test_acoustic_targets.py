@@ -249,3 +249,24 @@ def test_a_vowel_answer_is_drawn_without_the_maps(found_vowel, tmp_path):
                                    str(tmp_path / "v.png"), "--maps", str(tmp_path / "none.h5")])
     assert res.exit_code == 0, res.output
     assert (tmp_path / "v.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_the_tongue_tops_of_the_rest_jaw_and_the_rest_tongue_are_kept_apart():
+    """A jaw position named "rest" and the model's rest tongue (the classes' reference) are two things."""
+    from types import SimpleNamespace
+
+    from artic_cli.control.epmap import EPMaps
+    from artic_cli.control.tongue_tops import TongueTops
+
+    nodes = np.array([[0.0, 1.0, 0.0], [-1.0, 2.0, 0.0], [-2.0, 1.0, 0.0]])  # tip first, top at (-1, 2)
+    mesh = SimpleNamespace(node_sets={"surface": np.array([[9, 0, 9], [9, 1, 9], [9, 2, 9]]).ravel()})
+    lv = np.array([0.0, 1.0])
+    shapes = np.stack([nodes, nodes + [0.0, 0.5, 0.0]])
+    net = Net(muscles=("A",), levels=(lv,), x=np.zeros((2, 3, 3)), converged=np.ones(2, bool), drift_cm=np.zeros(2),
+              shapes=shapes)
+    maps = EPMaps(jaws={"rest": JawMaps(forces={}, rest=np.zeros((3, 3)), single={"A": net})}, typical_jaw="rest",
+                  model_rest=nodes)
+    tops = TongueTops(mesh, lambda: maps)
+    assert tops("rest")["single/A"] == pytest.approx(np.array([[-1.0, 2.0], [-1.0, 2.5]]))
+    assert tops.rest == pytest.approx([-1.0, 2.0])
+    assert isinstance(tops("rest"), dict)
