@@ -237,7 +237,8 @@ class Speech(Strict):
     # time constants (beyond the paper, whose forces follow their commands at once: 0, 0)
     activation_rise_ms: Annotated[float, Field(ge=0, le=200, allow_inf_nan=False)] = 0.0
     activation_fall_ms: Annotated[float, Field(ge=0, le=200, allow_inf_nan=False)] = 0.0
-    lip_ramp_ms: Annotated[float, Field(ge=0, le=500, allow_inf_nan=False)] = 60.0  # the lips and velum move over this
+    # the lips and velum move over this, centred on each segment's start
+    lip_ramp_ms: Annotated[float, Field(ge=0, le=500, allow_inf_nan=False)] = 60.0
     voicing_ramp_ms: Annotated[float, Field(ge=1, le=200, allow_inf_nan=False)] = 20.0  # voice on / off
     lung_pressure_kpa: Annotated[float, Field(gt=0, le=4, allow_inf_nan=False)] = 0.8  # 8 cm H2O, speech at normal effort
     glottal_area_voiceless_cm2: Annotated[float, Field(gt=0, le=2, allow_inf_nan=False)] = 0.3  # abducted

@@ -216,12 +216,13 @@ def move(model: Model, c: Course, cfg: Config, lap: Laps, progress=None, rest=No
 
 
 def tracts_of_run(u: Utterance, p: Plan, model: Model, traj: Trajectory, cfg: Config) -> Tracts:
-    """The tract of every frame: the lips and port of each segment's target (the config's before the first) and
-    each segment's glottis, then the utterance's own course."""
+    """The tract of every frame: the lips and port of each segment's target (the config's before the first; each
+    moves over ``lip_ramp_ms`` centred on its segment's start) and each segment's glottis, then the utterance's
+    own course."""
     vt = speaker_tract(cfg)
     shapes = shapes_of_model(model, traj.x, traj.time)
     lip_ramp = cfg.speech.lip_ramp_ms
-    entries = [TractEntry(at_ms=float(s * 1e3), ramp_ms=lip_ramp if k else 0.0, lip_area_cm2=a, lip_length_cm=l,
+    entries = [TractEntry(at_ms=max(float(s * 1e3) - lip_ramp / 2, 0.0), ramp_ms=lip_ramp if k else 0.0, lip_area_cm2=a, lip_length_cm=l,
                           velum_port_cm2=port)
                for k, (s, (a, l), port, solved) in enumerate(zip(p.starts_s, p.lips, p.ports, p.solutions))
                if solved]  # a segment of given forces asks nothing of the lips and the port
