@@ -222,7 +222,8 @@ def tracts_of_run(u: Utterance, p: Plan, model: Model, traj: Trajectory, cfg: Co
     vt = speaker_tract(cfg)
     shapes = shapes_of_model(model, traj.x, traj.time)
     lip_ramp = cfg.speech.lip_ramp_ms
-    entries = [TractEntry(at_ms=max(float(s * 1e3) - lip_ramp / 2, 0.0), ramp_ms=lip_ramp if k else 0.0, lip_area_cm2=a, lip_length_cm=l,
+    entries = [TractEntry(at_ms=max(float(s * 1e3) - lip_ramp / 2, 0.0), ramp_ms=lip_ramp if k else 0.0,
+                          lip_area_cm2=a, lip_length_cm=l,
                           velum_port_cm2=port)
                for k, (s, (a, l), port, solved) in enumerate(zip(p.starts_s, p.lips, p.ports, p.solutions))
                if solved]  # a segment of given forces asks nothing of the lips and the port
