@@ -105,10 +105,12 @@ class TongueHighest(Strict):
         """(..., 2) how far (x, y cm, >= 0) highest points ``top`` (..., 2) fall short of the class."""
         height, frontness = self.tongue.split("-")
         d = np.asarray(top, float) - np.asarray(rest_top, float)
-        sx = {"front": 1.0, "back": -1.0}.get(frontness, 0.0)
-        sy = {"high": 1.0, "low": -1.0}.get(height, 0.0)
-        return np.stack([np.where(sx != 0, np.maximum(self.margin_cm - sx * d[..., 0], 0.0), 0.0),
-                         np.where(sy != 0, np.maximum(self.margin_cm - sy * d[..., 1], 0.0), 0.0)], axis=-1)
+        out = np.zeros_like(d)
+        signs = ({"front": 1.0, "back": -1.0}.get(frontness), {"high": 1.0, "low": -1.0}.get(height))  # x, y
+        for axis, sign in enumerate(signs):
+            if sign is not None:  # mid and central ask nothing
+                out[..., axis] = np.maximum(self.margin_cm - sign * d[..., axis], 0.0)
+        return out
 
 
 class Lips(Strict):

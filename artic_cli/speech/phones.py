@@ -98,7 +98,8 @@ def glide_target(sym: str, g: Phoneme, inv: Inventory, lips, tongue_of: TongueOf
     narrows the palate), when ``tongue_of`` tells where."""
     t = constriction_target(sym, g, inv, g.channel_cm2, lips)
     if g.like is not None and tongue_of is not None:
-        t["indecisive"] = [{"point": k, "at_cm": [round(float(c), 4) for c in xy]} for k, xy in tongue_of(g.like).items()]
+        t["indecisive"] = [{"point": k, "at_cm": [round(float(c), 4) for c in xy]}
+                           for k, xy in tongue_of(g.like).items()]
     return t
 
 

@@ -16,11 +16,11 @@ place read frame by frame, and the leads and presses moved by what was measured:
 * one still held more than ``HELD_MS`` after its end brings the next segment's switch forward by as long
   (a release on time: a stop's burst inside its interval, a voiced closure no longer than its voicing lasts).
 
-A round whose simulation is not physical (an inverted brick) is never kept, and every press above 1 softens
-a step for the next.  Leads keep the switches in order (``MIN_GAP_MS`` apart); a segment whose lead or press the utterance gives is
-left as given.  The rounds stop when nothing moves or every constriction is on time; the round that missed
-the fewest ms of its constrictions' intervals is the one kept (the corrections of a closure and of the channel
-after it can swing), with what it measured.
+A round whose simulation is not physical (an inverted brick) is never kept, and every press above 1 softens a
+step for the next.  Leads keep the switches in order (``MIN_GAP_MS`` apart); a segment whose lead or press the
+utterance gives is left as given.  The rounds stop when nothing moves or every constriction is on time; the
+round that missed the fewest ms of its constrictions' intervals is the one kept (the corrections of a closure
+and of the channel after it can swing), with what it measured.
 """
 
 from __future__ import annotations

@@ -207,8 +207,9 @@ def speak(utterance: Path | str | Utterance, out: Path | str | None = None, maps
     cfg = load_config(config)
     out = _check_out(out if out is not None else paths.UTTERANCES / f"{u.name}.wav")
     folder = Path(solutions) if solutions is not None else out.parent / "solutions"
-    u = with_phonemes(u, cfg, inventory, partial(solve_runs.solve_batch, maps=maps, mesh=mesh, acoustic_maps=acoustic_maps,
-                                                 config=config, folder=folder, budget=budget, jobs=jobs, dynamic=None))
+    solve_on = partial(solve_runs.solve_batch, maps=maps, mesh=mesh, acoustic_maps=acoustic_maps, config=config,
+                       folder=folder, budget=budget, jobs=jobs)  # targets -> answers, the dynamic map given below
+    u = with_phonemes(u, cfg, inventory, partial(solve_on, dynamic=None))
     m = mesh_stage.read(mesh, cfg)
     targets = segment_targets(u, source, cfg.muscles.max_force_n)
     # the recipe: what the targets are solved on and with, so an unchanged utterance is known without solving
@@ -226,9 +227,7 @@ def speak(utterance: Path | str | Utterance, out: Path | str | None = None, maps
         return SpeakResult(files, None, up_to_date=True)
     model = sim_stage.build(cfg, m.mesh, m.wall)
     check_forces(u, list(model.drivable()), str(source or u.name))
-    solve = partial(solve_runs.solve_batch, maps=maps, mesh=mesh, acoustic_maps=acoustic_maps, config=config,
-                    folder=folder, budget=budget, jobs=jobs,
-                    dynamic=dynamic if dynamic is not None and needs_dynamic(targets, cfg) else None)
+    solve = partial(solve_on, dynamic=dynamic if dynamic is not None and needs_dynamic(targets, cfg) else None)
     view = STAGE.view(cfg)
     p = plan(u, view, targets, solve, accept_nearest, say)
     rest = settle(model)
