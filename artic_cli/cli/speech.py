@@ -19,8 +19,12 @@ def speak_cmd(
     utterance: Optional[Path] = typer.Argument(None, help="Utterance file (YAML): segments (a phoneme, a target "
                                                           "or forces, a duration), an F0 contour, a lip and velum "
                                                           "course.  Or give --text."),
-    text: Optional[str] = typer.Option(None, "--text", help="Romaji to speak (e.g. 'aga'): the inventory's phones "
-                                                            "at their default durations."),
+    text: Optional[str] = typer.Option(None, "--text", help="Japanese to speak: Hepburn or kunrei romaji, or kana "
+                                       "(e.g. 'konnichiwa', \"ha'shi\": the pitch falls after 'ha'; ',' a pause); "
+                                       "mora-timed, devoiced, its pitch from the accents."),
+    rate: float = typer.Option(1.0, "--rate", help="Speaking rate with --text (0.5-2; 2: morae half as long)."),
+    f0_range: Optional[str] = typer.Option(None, "--f0-range", help="LOW,HIGH Hz of the --text pitch (default "
+                                           "the inventory's, 95,135)."),
     inventory: Optional[Path] = typer.Option(None, "--inventory", help="Phoneme inventory (default "
                                                                        "configs/phonemes/japanese.yaml)."),
     out: Optional[Path] = typer.Option(None, "--out", help="Sound to write (WAV); the TextGrid and NAME.h5 go "
@@ -57,7 +61,10 @@ def speak_cmd(
         from ..speech.inventory import DEFAULT, load_inventory
         from ..speech.text import utterance_of_text
 
-        utterance = utterance_of_text(text, load_inventory(inventory or DEFAULT))
+        utterance = utterance_of_text(text, load_inventory(inventory or DEFAULT), rate=rate,
+                                      f0_range_hz=_f0_range(f0_range))
+    elif rate != 1.0 or f0_range is not None:
+        raise ArticError("--rate and --f0-range shape --text; an utterance file gives its durations and f0_hz")
     if page is not None:  # the page's pictures are drawn beside it
         plot, animate = plot or page.with_suffix(".png"), animate or page.with_suffix(".gif")
     for opt, p, ext in (("--plot", plot, ".png"), ("--animate", animate, ".gif"), ("--html", page, ".html")):
@@ -72,6 +79,18 @@ def speak_cmd(
         _draw(res.paths, plot, animate, mesh, config)
     if page is not None:
         _page(res.paths, page, plot, animate)
+
+
+def _f0_range(value: str | None) -> tuple[float, float] | None:
+    if value is None:
+        return None
+    try:
+        lo, hi = (float(v) for v in value.split(","))
+    except ValueError:
+        raise ArticError(f"--f0-range {value}: give LOW,HIGH in Hz, e.g. --f0-range 90,140") from None
+    if not 50 <= lo < hi <= 500:  # NaN fails too
+        raise ArticError(f"--f0-range {value}: give LOW,HIGH in Hz with 50 <= LOW < HIGH <= 500")
+    return lo, hi
 
 
 def _page(files: dict, page: Path, plot: Path, animate: Path) -> None:

@@ -109,6 +109,40 @@ class Realisation(Strict):
     voiced_stop_expansion_cm3_s: Annotated[float, Field(ge=0, le=500, allow_inf_nan=False)] = 120.0
 
 
+Factor = Annotated[float, Field(ge=1, le=3, allow_inf_nan=False)]
+
+
+class Timing(Strict):
+    """Mora-timed durations (:mod:`artic_cli.speech.durations`, docs/inventory.md, "Words")."""
+
+    mora_ms: Annotated[float, Field(ge=60, le=400, allow_inf_nan=False)] = 150.0  # at rate 1
+    vowel_min_share: Share = 0.4  # of a mora: a CV mora's vowel at least this, whatever its consonant
+    geminate_ratio: Annotated[float, Field(gt=1, le=5, allow_inf_nan=False)] = 2.8  # Q + C over C
+    before_coda: Factor = 1.11  # a vowel before Q or N, the coda shortened as much
+    devoiced_fricative_share: Share = 0.75  # of a mora: a fricative or affricate before its devoiced vowel
+    final_lengthening: Factor = 1.3  # the phrase-final mora's vowel or nasal
+    pause_ms: Annotated[float, Field(ge=50, le=2000, allow_inf_nan=False)] = 250.0  # a ',' at rate 1
+
+
+Hz = Annotated[float, Field(ge=50, le=500, allow_inf_nan=False)]
+
+
+class Pitch(Strict):
+    """A Tokyo-accent F0 contour (:mod:`artic_cli.speech.accent`, docs/inventory.md, "Pitch")."""
+
+    f0_range_hz: Annotated[list[Hz], Field(min_length=2, max_length=2)] = [95.0, 135.0]  # the low and high levels
+    initial_low_share: Share = 0.4  # a phrase's first low mora: this share of the range above the low level
+    declination_hz_s: Annotated[float, Field(ge=0, le=100, allow_inf_nan=False)] = 10.0  # both levels fall so
+    downstep: Share = 0.7  # after an accented word, the high level keeps this share of its span
+
+    @model_validator(mode="after")
+    def _range(self):
+        lo, hi = self.f0_range_hz
+        if not lo < hi:
+            raise ValueError(f"f0_range_hz: the low level {lo:g} Hz must be below the high {hi:g} Hz")
+        return self
+
+
 class Inventory(Strict):
     schema_version: Literal[1]
     language: str
@@ -117,6 +151,8 @@ class Inventory(Strict):
     jaws: dict[Place, Jaw] = {}  # a consonant's jaw position at its place, unless its entry gives one
     vowel_jaw_beside: dict[Place, Jaw] = {}  # a vowel next to a consonant of this place: at most this open
     realisation: Realisation = Realisation()
+    timing: Timing = Timing()
+    pitch: Pitch = Pitch()
     phonemes: dict[str, Phoneme]
 
     @model_validator(mode="after")
@@ -168,4 +204,4 @@ def load_inventory(path: Path | str = DEFAULT) -> Inventory:
                  "phoneme inventory (schema_version, places, phonemes)", "fix the inventory and rerun")
 
 
-__all__ = ["Inventory", "Phoneme", "Realisation", "SYMBOLS", "load_inventory"]
+__all__ = ["Inventory", "Phoneme", "Pitch", "Realisation", "SYMBOLS", "Timing", "load_inventory"]

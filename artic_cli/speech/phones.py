@@ -11,7 +11,7 @@ controls its inventory entry asks for (docs/inventory.md, "From a phoneme to a t
   points.
 * An affricate is a closure (at its ``closure_place`` if it names one) then a channel, a palatalized consonant
   its consonant then the palatal glide, a geminate the next consonant held a mora longer, the moraic nasal a
-  closure at the next consonant's place: each part a segment of its own, the later parts ``continues`` (one
+  closure at the next stop's, nasal's or affricate's place (else a nasalised vowel): each part a segment of its own, the later parts ``continues`` (one
   TextGrid interval per phoneme).
 * A nasal opens the velum port ``nasal_margin_ms`` before it and closes it as long after it; a voiceless
   phoneme abducts the glottis (its ``glottis_cm2`` or the config's voiceless opening).
@@ -109,6 +109,8 @@ def _parts(sym: str, p: Phoneme, inv: Inventory, lips, beside=(), tongue_of: Ton
     (``beside``: a vowel's neighbouring consonants)."""
     if p.manner == "vowel":
         return [(vowel_target(sym, p, inv, beside), 1.0, False)]
+    if p.place is None:  # the moraic nasal as a nasalised vowel: the tongue of the segment before
+        return [(None, 1.0, False)]
     if p.place in TONGUELESS:
         if p.palatalized:  # the tongue body takes the palatal glide's place during the lips' or glottis' gesture
             return [(glide_target(f"{sym}_y", _colouring(inv), inv, lips), 1.0, True)]
@@ -145,17 +147,20 @@ def _neighbour(symbols: list[str], k: int, step: int, inv: Inventory) -> Phoneme
 
 
 def _stand_in(symbols: list[str], k: int, inv: Inventory) -> Phoneme:
-    """What the moraic nasal or the geminate at ``k`` is made as: N a nasal at the next consonant's place
-    (velar when none follows or the next one's place is glottal), Q the next consonant itself."""
+    """What the moraic nasal or the geminate at ``k`` is made as: N a nasal at the next consonant's place (m
+    before p b m, n before t d n, velar before k g), a nasalised vowel (no place: the tongue held) before a
+    vowel, glide, fricative or nothing; Q the next consonant itself."""
     nxt = _next_consonant(symbols, k, inv)
     if symbols[k] == "Q":
         if nxt is None:
             raise ArticError(f"segments[{k}]: the geminate Q needs a consonant after it (e.g. 'aQta')")
         return inv.phonemes[nxt]
-    place = inv.phonemes[nxt].place if nxt is not None else None
-    n = inv.phonemes["m" if place == "bilabial" else "n"]
-    place = "velar" if place in (None, "glottal") else place
-    return n if n.place == place else n.model_copy(update={"place": place, "lips": "neutral"})
+    after = inv.phonemes[nxt] if nxt is not None else None
+    if after is None or after.place == "glottal" or after.manner in ("fricative", "approximant"):
+        # a nasalised vowel before a vowel, glide, fricative or pause: the tongue stays, the port opens
+        return inv.phonemes["n"].model_copy(update={"place": None, "lips": "neutral"})
+    n = inv.phonemes["m" if after.place == "bilabial" else "n"]
+    return n if n.place == after.place else n.model_copy(update={"place": after.place, "lips": "neutral"})
 
 
 def realise(u: Utterance, inv: Inventory, default_lips: tuple[float, float], tongue_of: TongueOf | None = None
@@ -181,7 +186,7 @@ def realise(u: Utterance, inv: Inventory, default_lips: tuple[float, float], ton
         p = _stand_in(symbols, k, inv) if sym in ("N", "Q") else inv.phonemes[sym]
         nv = _next_vowel(symbols, k, inv)
         lips = _lips(p) if p.lips != "neutral" else (_lips(nv) if nv is not None else None)
-        voiced = p.voiced if sym != "N" else True
+        voiced = (p.voiced if sym != "N" else True) and not seg.devoiced
         glottis = p.glottis_cm2
         closing = voiced and p.manner in ("stop", "affricate", "tap") and p.velum_port_cm2 == 0 and sym not in ("N", "Q")
         expand = inv.realisation.voiced_stop_expansion_cm3_s if closing else None

@@ -1,4 +1,4 @@
-"""An utterance's phones as a Praat TextGrid."""
+"""An utterance's phones (and the front end's morae and words) as a Praat TextGrid."""
 
 from __future__ import annotations
 
@@ -7,6 +7,7 @@ from pathlib import Path
 from ..io.store import atomic_path
 
 TIER = "phones"
+PAUSE = "pause"  # a pause segment's label: silence ("") in the TextGrid
 
 
 def intervals(p) -> list[tuple[float, float, str]]:
@@ -19,17 +20,21 @@ def intervals(p) -> list[tuple[float, float, str]]:
             out[-1][1] = b
         else:
             out.append([a, b, lab])
-    return [tuple(i) for i in out]
+    return [tuple(i) for i in out if i[2] != PAUSE]
 
 
-def write_textgrid(path: Path | str, p) -> Path:
-    """One interval tier 'phones' from a plan's labels, starts and durations (Praat reads it directly)."""
+def write_textgrid(path: Path | str, p, tiers: dict | None = None) -> Path:
+    """The interval tier 'phones' from a plan's labels, starts and durations, then ``tiers`` (name -> intervals
+    with ``start_ms``, ``end_ms``, ``label``; the utterance's), each as an interval tier (Praat reads it)."""
     from praatio import textgrid
 
     iv = intervals(p)
-    tier = textgrid.IntervalTier(TIER, iv, 0.0, iv[-1][1])
+    end = round(float(p.starts_s[-1] + p.durations_s[-1]), 9)
     tg = textgrid.Textgrid()
-    tg.addTier(tier)
+    tg.addTier(textgrid.IntervalTier(TIER, iv, 0.0, end))
+    for name, spans in (tiers or {}).items():
+        entries = [(round(s.start_ms / 1e3, 9), round(min(s.end_ms / 1e3, end), 9), s.label) for s in spans]
+        tg.addTier(textgrid.IntervalTier(name, entries, 0.0, end))
     with atomic_path(path, ".TextGrid") as tmp:
         tg.save(str(tmp), format="long_textgrid", includeBlankSpaces=True)
     return Path(path)

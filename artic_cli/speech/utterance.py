@@ -18,6 +18,8 @@ Example::
     tract:                               # optional lip, velum and glottis course on top of the targets'
       - {at_ms: 250, ramp_ms: 40, lip_area_cm2: 0.0}
       - {at_ms: 330, ramp_ms: 30, glottis_cm2: 0.3, velum_port_cm2: 0.5}
+    tiers:                               # optional TextGrid tiers beside 'phones' (the front end's morae, words)
+      words: [{start_ms: 0, end_ms: 600, label: aka}]
 
 A segment's ``lead_ms`` overrides the utterance's for its forces alone (a stop's closing gesture starts earlier,
 its release comes with the next segment's forces); ``press`` scales a solved target's tongue-muscle forces, up
@@ -53,6 +55,7 @@ class Segment(Strict):
     glottis_cm2: Annotated[float, Field(ge=0, le=2, allow_inf_nan=False)] | None = None  # ... or this opening
     # the cavity enlarging at this rate while the closure the segment makes lasts (a voiced stop or tap)
     cavity_expansion_cm3_s: Annotated[float, Field(ge=0, le=500, allow_inf_nan=False)] | None = None
+    devoiced: bool = False  # a vowel phoneme spoken voiceless (the glottis open; its tongue and lips kept)
     label: SafeName | None = None  # the TextGrid's label (default: the target's name)
     lead_ms: Annotated[float, Field(ge=0, le=300, allow_inf_nan=False)] | None = None  # else the utterance's
     press: Annotated[float, Field(ge=0.5, le=3, allow_inf_nan=False)] = 1.0  # the target's tongue forces x this (below 1: softer)
@@ -64,9 +67,17 @@ class Segment(Strict):
         if len(given) != 1:
             raise ValueError("give either 'target' (a target file or one inline), 'phoneme' (a symbol of the "
                              "inventory) or 'forces_n', one of them")
+        if self.devoiced and self.phoneme is None:
+            raise ValueError("'devoiced' belongs to a vowel phoneme segment ({phoneme: u, devoiced: true})")
         if self.forces_n is not None and self.press != 1.0:
             raise ValueError("'press' scales a solved target's forces; with 'forces_n' give the pressed forces")
         return self
+
+
+class Interval(Strict):
+    start_ms: Annotated[float, Field(ge=0, allow_inf_nan=False)]
+    end_ms: Annotated[float, Field(gt=0, allow_inf_nan=False)]
+    label: str
 
 
 class Utterance(Strict):
@@ -79,6 +90,7 @@ class Utterance(Strict):
     prepare_ms: Annotated[float, Field(ge=0, le=1000, allow_inf_nan=False)] | None = None  # else speech.prepare_ms
     force_course: Literal["static", "pulse_step"] | None = None  # the config's speech.force_course otherwise
     tract: list[TractEntry] = []
+    tiers: dict[str, list[Interval]] = {}
 
     @field_validator("f0_hz")
     @classmethod
@@ -102,6 +114,15 @@ class Utterance(Strict):
             if e.at_ms >= total:
                 raise ValueError(f"tract[{k}].at_ms = {e.at_ms:g} is not inside the utterance (its segments end at "
                                  f"{total:g} ms); move the entry or lengthen a segment")
+        for name, tier in self.tiers.items():
+            if name == "phones":
+                raise ValueError("tiers.phones: the phones tier is made from the segments; name yours otherwise")
+            end = 0.0
+            for k, iv in enumerate(tier):
+                if iv.start_ms < end - 1e-6 or iv.end_ms <= iv.start_ms or iv.end_ms > total + 1e-6:
+                    raise ValueError(f"tiers.{name}[{k}]: {iv.start_ms:g}-{iv.end_ms:g} ms must follow the one "
+                                     f"before, end after it starts and lie inside the {total:g}-ms utterance")
+                end = iv.end_ms
         return self
 
     @property
@@ -146,4 +167,4 @@ def check_forces(u: Utterance, valid: list[str], source: str) -> None:
                 raise ArticError(f"{source}: segments[{k}].forces_n: '{name}' is unknown; valid: {', '.join(valid)}")
 
 
-__all__ = ["Segment", "Utterance", "load_utterance", "parse_utterance", "target_path", "check_forces"]
+__all__ = ["Interval", "Segment", "Utterance", "load_utterance", "parse_utterance", "target_path", "check_forces"]

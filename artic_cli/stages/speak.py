@@ -71,7 +71,7 @@ AIR_UNITS = {"oral_pressure": "dyn/cm^2 (the cavity behind the narrowest place)"
 def write(wav: Path | str, s: Spoken, prov=None) -> dict[str, Path]:
     """The WAV, the TextGrid, then the HDF5 record (last: it is what says the three are up to date)."""
     write_wav(wav, s.audio)
-    tg = write_textgrid(textgrid_path(wav), s.plan)
+    tg = write_textgrid(textgrid_path(wav), s.plan, s.utterance.tiers)
     h5 = h5_path(wav)
     p, tr = s.plan, s.tracts
     with atomic_h5(h5, "utterance", prov) as f:

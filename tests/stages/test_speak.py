@@ -456,8 +456,14 @@ def test_a_spoken_utterance_gets_a_page_to_look_at_and_listen_to(spoken, mesh_fi
     assert text.count("<tr>") == 7  # a header and the six segments
 
 
-@pytest.mark.parametrize("args, says", [(["--text", "ax"], "'x' at position 2 is not in the inventory"),
-                                        (["--text", "   "], "give some romaji"), ([], "give an utterance file or --text")])
+@pytest.mark.parametrize("args, says", [(["--text", "ax"], "'x' at position 2 is not romaji"),
+                                        (["--text", "   "], "give some romaji"), ([], "give an utterance file or --text"),
+                                        (["--text", "ka" * 201], "201 morae is more than the 200"),
+                                        (["--text", "'aka"], "accent mark on no mora"),
+                                        (["--text", "aka", "--rate", "3"], "--rate 3: give a factor from 0.5 to 2"),
+                                        (["--text", "aka", "--f0-range", "140,90"], "50 <= LOW < HIGH <= 500"),
+                                        (["--text", "aka", "--f0-range", "x"], "give LOW,HIGH in Hz"),
+                                        (["--rate", "1.5"], "give an utterance file or --text")])
 def test_bad_text_is_one_line_and_exit_2_with_nothing_written(tmp_path, mesh_file, args, says):
     res = _run("speak", *args, "--mesh", mesh_file, "--out", tmp_path / "out" / "x.wav", "--maps", tmp_path / "none.h5")
     assert res.exit_code == 2 and says in res.output and "Traceback" not in res.output, res.output
