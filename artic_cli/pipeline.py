@@ -38,6 +38,7 @@ class Pipeline(Strict):
     targets: list[str] = []
     vowels: list[str] = []  # configs/targets/vowels/*.yaml
     utterances: list[str] = []  # configs/utterances/*.yaml
+    words: list[str] = []  # configs/words/*.yaml (text)
 
 
 def load_pipeline(path: Path | str) -> Pipeline:
@@ -63,6 +64,9 @@ def load_pipeline(path: Path | str) -> Pipeline:
     for name in p.utterances:
         if not (ROOT / "configs" / "utterances" / f"{name}.yaml").is_file():
             raise ArticError(f"{path}: utterance '{name}' has no configs/utterances/{name}.yaml")
+    for name in p.words:
+        if not (ROOT / "configs" / "words" / f"{name}.yaml").is_file():
+            raise ArticError(f"{path}: word '{name}' has no configs/words/{name}.yaml")
     return p
 
 

@@ -111,13 +111,14 @@ def utterance_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row
 
 def spoken_phones(records, manners: dict[str, str]):
     """(path, record, phone intervals) of each record with a TextGrid that holds a consonant of the inventory."""
+    from ..speech.judge import devoiced_marked
     from ..speech.textgrid import read_phones
 
     for path, rec in records:
         tg = path.with_suffix(".TextGrid")
         if not tg.is_file():
             continue
-        iv = read_phones(tg)
+        iv = devoiced_marked(read_phones(tg), rec.starts_s, rec.voiced, manners)
         if any(manners.get(lab) not in (None, "vowel") for _, _, lab in iv):
             yield path, rec, iv
 

@@ -122,7 +122,7 @@ def measure(x, rate, iv: tuple[float, float, str], vowels: list[tuple[float, flo
     frames = voiced_frames(x, rate) if frames is None else frames
     ref = vowel_reference(x, rate, vowels)
     t, db = rms_contour_db(x, rate) if contour is None else contour
-    out = {"symbol": sym, "manner": manner, "duration_ms": 1e3 * (t1 - t0),
+    out = {"symbol": sym, "manner": manner, "start_s": t0, "duration_ms": 1e3 * (t1 - t0),
            "voiced_share": share_voiced(x, rate, t0, t1, frames),
            "level_db": band_power_db(x, rate, t0, t1) - ref["level_db"]}
     inside = (t >= t0) & (t <= t1)

@@ -6,7 +6,12 @@ from __future__ import annotations
 
 import re
 
+from typing import Annotated
+
+from pydantic import Field
+
 from ..errors import ArticError
+from ..validation import SafeName, Strict, parse
 from .accent import f0_points
 from .devoicing import devoice
 from .durations import mora_phones_ms
@@ -102,4 +107,23 @@ def utterance_of_text(text: str, inv: Inventory, name: str | None = None, rate: 
                             "tiers": {"morae": morae_tier, "words": words_tier}}, f"--text {text!r}")
 
 
-__all__ = ["utterance_of_text", "text_name", "phrases_of", "MAX_MORAE"]
+class TextUtterance(Strict):
+    """An utterance file that gives text (``configs/words/*.yaml``): ``{name: kitte, text: kitte}``, optionally a
+    ``rate`` and an ``f0_range_hz`` [low, high]."""
+
+    name: SafeName | None = None
+    text: str
+    rate: Annotated[float, Field(ge=RATES[0], le=RATES[1], allow_inf_nan=False)] = 1.0
+    f0_range_hz: Annotated[list[Annotated[float, Field(ge=50, le=500, allow_inf_nan=False)]],
+                           Field(min_length=2, max_length=2)] | None = None
+
+
+def text_utterance(data: dict, source: str, inv: Inventory) -> Utterance:
+    t = parse(TextUtterance, data, source, "text utterance (name, text, rate, f0_range_hz)", "fix it and rerun")
+    try:
+        return utterance_of_text(t.text, inv, t.name, t.rate, None if t.f0_range_hz is None else tuple(t.f0_range_hz))
+    except ArticError as err:
+        raise ArticError(f"{source}: {err}") from None
+
+
+__all__ = ["TextUtterance", "text_utterance", "utterance_of_text", "text_name", "phrases_of", "MAX_MORAE"]

@@ -12,6 +12,7 @@ from ..report.mechanics import articulator_section, function_rows, tissue_sectio
 from ..report.run import run_section
 from ..report.speech import utterance_section, vowel_section
 from ..report.tract import tract_section
+from ..report.words import word_section
 from . import paths
 from .base import Stage
 
@@ -21,7 +22,8 @@ STAGE = Stage(name="report", module=__name__, sections=(),
 
 SECTIONS = {"tissue": tissue_section, "articulator": articulator_section, "tract": tract_section,
             "function": function_rows,
-            "maps": map_section, "vowels": vowel_section, "utterances": utterance_section, "run": run_section}
+            "maps": map_section, "vowels": vowel_section, "utterances": utterance_section, "words": word_section,
+            "run": run_section}
 
 
 def write_report(data: Path | str = paths.DATA, out: Path | str = paths.REPORT) -> Path:
@@ -34,7 +36,9 @@ def write_report(data: Path | str = paths.DATA, out: Path | str = paths.REPORT) 
              "computed by the run, none typed in."]
     for section in REPORT:
         fn = SECTIONS[section.key]
-        rows, extra = fn(data, out.parent) if section.key in ("tract", "vowels", "utterances") else fn(data)
+        rows, extra = fn(data, out.parent) if section.key in ("tract", "vowels", "utterances", "words") else fn(data)
+        if not rows and not extra and section.key == "words":
+            continue  # a pipeline that speaks no words has no words section
         lines += ["", f"## {section.title}", ""] + extra
         lines += ["| item | paper | ours | verdict |", "|---|---|---|---|"]
         lines += [f"| {r.item} | {r.paper} | {r.ours} | {r.verdict} |" for r in rows]

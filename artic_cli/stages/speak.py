@@ -178,6 +178,17 @@ def _check_out(out: Path | str) -> Path:
     return out
 
 
+def read_utterance(path: Path | str, inventory: Path | str | None = None) -> Utterance:
+    """An utterance file: segments, or text (``text:``, spoken through the inventory's front end)."""
+    from ..config import read_yaml
+    from ..speech.text import text_utterance
+
+    data = read_yaml(path, "utterance file")
+    if isinstance(data, dict) and "text" in data:
+        return text_utterance(data, str(path), load_inventory(inventory or DEFAULT_INVENTORY))
+    return load_utterance(path)
+
+
 def with_phonemes(u: Utterance, cfg: Config, inventory: Path | str | None = None, solve=None) -> Utterance:
     """The utterance with its phoneme segments made targets and controls (the inventory read only if it has
     any; its places checked against the config's tract); ``solve`` (targets -> answers) places a glide's tongue
@@ -203,7 +214,7 @@ def speak(utterance: Path | str | Utterance, out: Path | str | None = None, maps
     solutions, mesh, config, code) is left alone.  ``dynamic``: the dynamic map, for targets at jaw positions
     the maps hold no nets for (read only for such a target)."""
     source = None if isinstance(utterance, Utterance) else utterance
-    u = utterance if source is None else load_utterance(source)
+    u = utterance if source is None else read_utterance(source, inventory)
     cfg = load_config(config)
     out = _check_out(out if out is not None else paths.UTTERANCES / f"{u.name}.wav")
     folder = Path(solutions) if solutions is not None else out.parent / "solutions"

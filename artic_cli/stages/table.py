@@ -81,6 +81,15 @@ STAGES: tuple[StageEntry, ...] = (
                items="utterances",
                figures=(Figure("{report}/utterance_{name}.png", "plot utterance {output}", "--out {figure}",
                                "artic_cli.plots.utterance"),)),
+    StageEntry("utterances-words", "artic_cli.stages.speak", "{out}/words/{name}.h5",
+               "speak configs/words/{name}.yaml --maps {maps} --dynamic {dynamic} --mesh {mesh} "
+               "--config {config} --acoustic-maps {out}/acoustic_maps.h5 --accept-nearest "
+               "--solutions {out}/utterances/solutions --out {out}/words/{name}.wav",
+               inputs=(MAPS, DYN, MESH, "{out}/acoustic_maps.h5", "configs/words/{name}.yaml",
+                       "configs/phonemes/japanese.yaml"),
+               items="words",
+               figures=(Figure("{report}/word_{name}.png", "plot utterance {output}", "--out {figure}",
+                               "artic_cli.plots.utterance"),)),
     StageEntry("vowels-audio", "artic_cli.stages.synthesize", "{out}/vowels/{name}.wav",
                "synthesize --solution {out}/vowels/{name}.yaml --duration 0.6 --f0-contour "
                "configs/voice/f0_fall_125_100.csv --config {config} --out {output}",
@@ -167,6 +176,7 @@ REPORT: tuple[ReportSection, ...] = (
                   ("epmaps", "dynamic", "solve")),
     ReportSection("vowels", "Vowels from formant targets (beyond the paper)", ("vowels", "vowels-audio")),
     ReportSection("utterances", "Utterances from target sequences (beyond the paper)", ("utterances",)),
+    ReportSection("words", "Words from text (beyond the paper)", ("utterances-words",)),
     ReportSection("run", "This run", ()),
 )
 REPORT_MODULE = "artic_cli.stages.report"
