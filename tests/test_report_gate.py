@@ -13,7 +13,8 @@ ACCEPTED = ("Cuboid: apparent Poisson ratio, Eq. (4)", "Figs. 5/6: GGp from", "T
             "Articulators (issue 45", "/acha/: peak speeds", "/anya/: peak speeds", "/arya/: peak speeds",
             "/asa/: peak speeds", "/uru/: peak speeds",
             "/aka/: closure", "/asa/: level above 3 kHz", "Vowels beside the consonants (issue 45",
-            "Centroids of /sh/ below /s/")
+            "Centroids of /sh/ below /s/",
+            "Words from text:")  # issue 46's goals, open: docs/inventory.md, "What is measured on words"
 
 
 def test_the_default_speakers_report_differs_only_where_accepted():
