@@ -39,7 +39,7 @@ def mora_phones_ms(phrase: list[Mora], inv: Inventory, rate: float = 1.0) -> lis
             out.append([mora])  # V, N, a long vowel's second mora
         if nxt is not None and nxt.phones in (["Q"], ["N"]) and m.vowel is not None:
             out[-1][-1] *= t.before_coda
-    for k in range(1, len(phrase)):  # the coda gives back what the vowel before it gained
+    for k in range(1, len(phrase)):  # the coda gives back what the vowel before it gained (keeping half its own)
         if phrase[k].phones in (["Q"], ["N"]) and phrase[k - 1].vowel is not None:
             v = out[k - 1][-1]
             out[k][0] = max(out[k][0] - (v - v / t.before_coda), 0.5 * out[k][0])

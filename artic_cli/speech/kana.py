@@ -44,7 +44,7 @@ def kana_romaji(kana: list[str]) -> list[str | None]:
     for ch in map(hiragana, kana):
         prev = out[-1] if out else None
         last = next((r for r in reversed(out) if r), None)  # the sound a long mark lengthens
-        if ch in SMALL_Y and prev and prev.endswith("i") and prev not in ("i",):
+        if ch in SMALL_Y and prev and prev.endswith("i") and prev != "i":
             base = PALATAL.get(prev, prev[:-1] + "y")
             out[-1] = base + SMALL_Y[ch]
             out.append("")
