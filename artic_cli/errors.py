@@ -13,6 +13,10 @@ class UnreachableTarget(ArticError):
     exit_code = 3
 
 
+class OffGrid(ArticError):
+    """A shape whose midline the tract's grid cannot trace (the tongue left the grid)."""
+
+
 class NotPhysical(ArticError):
     """A result that is not physical (NaN, an inverted brick, a Newton failure, lost volume): its file is
     written and marked invalid (exit status 4)."""

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..speech.measures import EMA_PEAK_CM_S, SPEED_MARGIN, too_fast
 from .rows import Row, verdict
 
 
@@ -45,16 +46,14 @@ def vowel_section(data: Path, out_dir: Path | None = None) -> tuple[list[Row], l
     return rows, lines + [""] + pictures + [""]
 
 
-EMA_PEAK_CM_S = {"tip": 40.0, "dorsum": 32.0, "jaw": 12.0}  # Table II's EMA ranges the paper cites
-SPEED_MARGIN, MAX_VOLUME, MAX_BEYOND_CM = 1.5, 0.003, 0.01  # the goals: EMA + 50 %, 0.3 %, 0.01 cm
+MAX_VOLUME, MAX_BEYOND_CM = 0.003, 0.01  # the goals: volume within 0.3 %, tissue within 0.01 cm of the wall
 
 
 def broken_limits(m: dict, rec) -> list[str]:
     """What a spoken record breaks of the mechanical goals (``m``: its measures): each too-fast articulator,
     the volume change, inverted bricks, the tissue beyond the wall; [] when it keeps them all."""
     sp = m["peak_speed_cm_s"]
-    out = [f"{k} {sp.get(k, np.nan):.0f} cm/s" for k, v in EMA_PEAK_CM_S.items()
-           if not sp.get(k, np.nan) <= SPEED_MARGIN * v]
+    out = [f"{k} {sp.get(k, np.nan):.0f} cm/s" for k in too_fast(sp)]
     inv, beyond = int(rec.attrs.get("inverted_bricks_max", 0)), float(rec.attrs.get("max_beyond_wall_cm", np.nan))
     if not m["max_volume_change"] <= MAX_VOLUME:
         out.append(f"volume {100 * m['max_volume_change']:.2f} %")

@@ -8,6 +8,22 @@ import numpy as np
 from ..acoustics.measures import band_level_db, runs
 from .record import Record
 
+EMA_PEAK_CM_S = {"tip": 40.0, "dorsum": 32.0, "jaw": 12.0}  # Table II's EMA ranges the paper cites
+SPEED_MARGIN = 1.5  # the mechanical goal: peak speeds within the EMA range + 50 %
+
+
+def peak_speeds(time_s: np.ndarray, points_cm: dict[str, np.ndarray]) -> dict[str, float]:
+    """Each control point's peak midsagittal speed (cm/s) over frames ``time_s`` (s) of its track (F, 3) cm."""
+    dt = np.diff(time_s)
+    return {name: float(np.max(np.linalg.norm(np.diff(xyz[:, :2], axis=0), axis=1) / dt)) if len(dt) else 0.0
+            for name, xyz in points_cm.items()}
+
+
+def too_fast(speeds_cm_s: dict[str, float]) -> dict[str, float]:
+    """The articulators faster than the EMA range + 50 %: each one's peak speed over that limit (> 1)."""
+    return {k: speeds_cm_s.get(k, np.nan) / (SPEED_MARGIN * v) for k, v in EMA_PEAK_CM_S.items()
+            if not speeds_cm_s.get(k, np.nan) <= SPEED_MARGIN * v}
+
 
 def measures(rec: Record, samples: np.ndarray, rate_hz: int) -> dict:
     """Per segment: median F1/F2 of our tracks over its middle half, its level (dB) overall and above 3 kHz,
@@ -30,8 +46,7 @@ def measures(rec: Record, samples: np.ndarray, rate_hz: int) -> dict:
         closures.append({"start_s": t0, "end_s": t1, "duration_ms": 1e3 * (t1 - t0),
                          "level_db": band_level_db(samples, rate_hz, t0 + 0.005, max(t1 - 0.005, t0 + 0.01))})
     dt = np.diff(t)
-    speeds = {name: float(np.max(np.linalg.norm(np.diff(xyz[:, :2], axis=0), axis=1) / dt)) if len(dt) else 0.0
-              for name, xyz in rec.control_points.items()}
+    speeds = peak_speeds(t, rec.control_points)
     cps = ("tip", "dorsum", "jaw")
     for k, seg in enumerate(segs):  # how far each control point still is from where the segment's forces lead
         end = min(np.searchsorted(t, seg["start_s"] + seg["duration_s"] - 1e-9), len(t) - 1)

@@ -104,15 +104,15 @@ def ramp_weights(starts_s: np.ndarray, values: np.ndarray, ramp_s: float, t: np.
 
 
 def segment_vectors(u: Utterance, p: Plan, model: Model, max_force_n: float) -> np.ndarray:
-    """(K, M) each segment's muscle forces (dyn), its tongue muscles pressed by the segment's ``press`` (a
-    press stops at the muscles' largest force)."""
+    """(K, M) each segment's muscle forces (dyn), its tongue muscles and jaw closers (the ``JC`` group) pressed by
+    the segment's ``press`` (a press stops at the muscles' largest force)."""
     names = list(model.drivable())
     for k, f in enumerate(p.forces_n):
         bad = [m for m in f if m not in names]
         if bad:
             raise ArticError(f"segment {k}: muscle '{bad[0]}' is unknown; valid: {', '.join(names)}")
-    tongue = set(TONGUE_MUSCLES)
-    return np.array([muscle_force_vector(model, {m: min(v * seg.press, max(v, max_force_n)) if m in tongue else v
+    pressed = set(TONGUE_MUSCLES) | {"JC"}
+    return np.array([muscle_force_vector(model, {m: min(v * seg.press, max(v, max_force_n)) if m in pressed else v
                                                  for m, v in f.items()})
                      for f, seg in zip(p.forces_n, u.segments)])
 

@@ -5,9 +5,11 @@ switches on late enough that it holds to the interval's end (docs/inventory.md, 
 The utterance is simulated (mechanics and area function only, no sound), the area at each constriction's
 place read frame by frame, and the leads and presses moved by what was measured:
 
-* a constriction reached ``late`` ms after its start leads by that much more;
-* one never reached presses harder (its tongue forces x ``PRESS_STEP``, at most ``PRESS_MAX``), leads
-  ``LEAD_STEP_MS`` more and holds its own next part's switch (an affricate's release) back as much;
+* a constriction reached ``late`` ms after its start leads by that much more, or, when it may not lead more,
+  presses harder, or, when it may press no harder, leads further into the vowel before it (:mod:`.leads`);
+* one never reached presses harder (its tongue forces and jaw closers x ``PRESS_STEP``, up to its ceiling),
+  leads ``LEAD_STEP_MS`` more (or, neither possible, further into the vowel) and holds its own next part's
+  switch (an affricate's release) back as much;
 * a channel never open to its area (an affricate's release after its closure) leads more and presses softer;
 * one released before its end (or, never made, narrowest before its end) delays the next segment's switch by
   as much;
@@ -16,11 +18,14 @@ place read frame by frame, and the leads and presses moved by what was measured:
 * one still held more than ``HELD_MS`` after its end brings the next segment's switch forward by as long
   (a release on time: a stop's burst inside its interval, a voiced closure no longer than its voicing lasts).
 
-A round whose simulation is not physical (an inverted brick) is never kept, and every press above 1 softens a
-step for the next.  Leads keep the switches in order (``MIN_GAP_MS`` apart); a segment whose lead or press the
-utterance gives is left as given.  The rounds stop when nothing moves or every constriction is on time; the
-round that missed the fewest ms of its constrictions' intervals is the one kept (the corrections of a closure
-and of the channel after it can swing), with what it measured.
+A round whose simulation is not physical (an inverted brick, a tongue off the tract's grid) is never kept, its
+presses become their ceilings less a step, and every press above 1 softens a step for the next; so after a round
+faster than a speaker moves (peak speeds beyond the EMA range + 50 %), which counts as missing the share it is
+too fast of every constriction's interval.  Leads keep their bounds (:mod:`.leads`: a segment after a vowel
+switches on no earlier than the vowel's middle until it may press no harder).  The rounds stop
+when nothing moves or every constriction is on time; the round that missed the fewest ms of its constrictions'
+intervals is the one kept (the corrections of a closure and of the channel after it can swing), with what it
+measured.
 """
 
 from __future__ import annotations
@@ -31,18 +36,19 @@ import numpy as np
 
 from ..config import Config
 from ..control.solver import TargetSpec
+from ..errors import OffGrid
 from ..mechanics.model import Model
 from ..mechanics.simulate import problems
 from ..tract.places import place_area, place_index, section_places
 from ..tract.speaker import speaker_tract
+from .leads import LEAD_STEP_MS, Leads, leads_of
+from .measures import peak_speeds, too_fast
 from .plan import Plan
 from .speak import course_trajectory, default_leads_ms, force_course, tracts_of_run
 from .utterance import Utterance
 
 ROUNDS = 9
 SLACK_MS = 3.0  # reached within this of the start, held to within this of the end: on time
-PRESS_STEP, PRESS_MAX = 1.15, 2.0
-LEAD_STEP_MS, LEAD_MAX_MS, MIN_GAP_MS = 20.0, 250.0, 10.0
 WINDOW_MS = 20.0  # a constriction made this long before its interval counts as reached at its start
 HELD_MS = 15.0  # a constriction held longer than this past its interval's end: the next segment leads more
 EARLY_MS = 40.0  # ... made longer than this before its start: its own segment leads less
@@ -142,71 +148,77 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
     if not goals:
         return u, None
     segs = u.segments
-    leads = np.array(u.leads_ms(default_leads_ms(u, cfg)[0]), float)
-    press = np.array([s.press for s in segs], float)
-    free_lead = [s.lead_ms is None for s in segs]
-    free_press = ["press" not in s.model_fields_set for s in segs]  # given (a glide's 1): kept; below 1 softens
-    starts = np.array(u.starts_ms(), float)
-    ends = starts + np.array([s.duration_ms for s in segs])
-    _in_order(leads, starts, free_lead)  # a short part (an affricate's release, a glide) leads no more than fits
+    kn = leads_of(u, targets, default_leads_ms(u, cfg)[0])
+    starts, ends = kn.starts, kn.starts + np.array([s.duration_ms for s in segs])
     best = None
     for r in range(rounds):
-        trial = _with(u, leads, press)
-        traj, areas = place_areas(trial, p, cfg, model, rest, goals)
-        if problems(traj, model.volume_constraint):  # pressed too hard: never kept, every press softer
-            if not soften(press, free_press):
+        trial = _with(u, kn.leads, kn.press)
+        try:
+            traj, areas = place_areas(trial, p, cfg, model, rest, goals)
+            bad = bool(problems(traj, model.volume_constraint))
+        except OffGrid:  # the tongue left the tract's grid
+            bad = True
+        if bad:  # pressed too hard: never kept, every press softer
+            if not kn.too_hard():
                 break
             continue
         t = traj.time
+        tried = kn.leads.copy(), kn.press.copy()
         late, early, held, soon = {}, {}, {}, {}
-        tried = leads.copy(), press.copy()
         changed = False
         for g in goals:
             k = g.segment
-            on, off = onset_and_release(t, areas[g.segment], g.reach_cm2, starts[k] / 1e3, ends[k] / 1e3, g.floor_cm2)
-            late[k], early[k] = on, off
-            if not np.isfinite(on):
-                inside = areas[g.segment][(t >= starts[k] / 1e3) & (t < ends[k] / 1e3)]
-                if len(inside) and inside.max() <= g.floor_cm2:  # a channel too narrow: earlier and softer
-                    if free_press[k] and press[k] > 1.0 / PRESS_MAX:
-                        press[k] = max(press[k] / PRESS_STEP, 1.0 / PRESS_MAX)
-                        changed = True
-                    changed |= _lead_more(leads, starts, k, LEAD_STEP_MS, free_lead)
-                    continue
-                if free_press[k] and press[k] < PRESS_MAX:
-                    press[k] = min(press[k] * PRESS_STEP, PRESS_MAX)
-                    changed = True
-                changed |= _lead_more(leads, starts, k, LEAD_STEP_MS, free_lead)
-                if k + 1 < len(segs) and segs[k + 1].continues and free_lead[k + 1] and leads[k + 1] > 0:
-                    # nor let its own next part (an affricate's release) cut it short
-                    leads[k + 1] = max(leads[k + 1] - LEAD_STEP_MS, 0.0)
-                    changed = True
-            elif on > SLACK_MS:
-                changed |= _lead_more(leads, starts, k, on, free_lead)
-            if off > SLACK_MS and k + 1 < len(segs) and free_lead[k + 1] and leads[k + 1] > 0:
-                leads[k + 1] = max(leads[k + 1] - off, 0.0)
-                changed = True
-            ahead = made_before(t, areas[g.segment], g.reach_cm2, starts[k] / 1e3, g.floor_cm2)
-            soon[k] = ahead
-            if ahead > EARLY_MS and free_lead[k] and leads[k] > 0 and not segs[k].continues:
-                leads[k] = max(leads[k] - (ahead - WINDOW_MS), 0.0)
-                changed = True
-            held[k] = held_after(t, areas[g.segment], g.reach_cm2, ends[k] / 1e3, g.floor_cm2) if np.isfinite(on) else 0.0
-            if held[k] > HELD_MS and k + 1 < len(segs) and not segs[k + 1].continues:
-                changed |= _lead_more(leads, starts, k + 1, held[k], free_lead)
-        _in_order(leads, starts, free_lead)
-        score = missed_ms(goals, late, early, starts, ends, areas, t) + sum(max(h - HELD_MS, 0.0) for h in held.values())
-        score += sum(max(a - EARLY_MS, 0.0) for a in soon.values())
+            area = areas[k]
+            late[k], early[k] = onset_and_release(t, area, g.reach_cm2, starts[k] / 1e3, ends[k] / 1e3, g.floor_cm2)
+            soon[k] = made_before(t, area, g.reach_cm2, starts[k] / 1e3, g.floor_cm2)
+            held[k] = held_after(t, area, g.reach_cm2, ends[k] / 1e3, g.floor_cm2) if np.isfinite(late[k]) else 0.0
+            changed |= correct(kn, g, segs, t, area, (late[k], early[k], soon[k], held[k]), ends[k])
+        kn.in_order()
+        score = missed_ms(goals, late, early, starts, ends, areas, t)
+        score += sum(max(h - HELD_MS, 0.0) for h in held.values()) + sum(max(a - EARLY_MS, 0.0) for a in soon.values())
+        fast = too_fast(peak_speeds(t, {n: traj.x[:, i] for n, i in model.control_points().items()}))
+        if fast:  # too fast: as bad as missing that share more of every constriction's interval; presses softer
+            score += (max(fast.values()) - 1.0) * sum(ends[g.segment] - starts[g.segment] for g in goals)
+            changed |= kn.too_hard()
         if best is None or score < best[0]:
             best = (score, r, tried, late, early, held, traj)
         if not changed or score == 0.0:
             break
     if best is None:  # no round was physical: the last, for the caller to refuse
-        return _with(u, leads, press), None
+        return _with(u, kn.leads, kn.press), None
     _, _, (leads, press), late, early, held, traj = best
     return _with(u, leads, press), Timing(leads_ms=leads.tolist(), press=press.tolist(), rounds=r + 1,
                                           onset_late_ms=late, released_early_ms=early, held_late_ms=held,
                                           trajectory=traj)
+
+
+def correct(kn: Leads, g: Goal, segs, t: np.ndarray, area: np.ndarray, measured: tuple, end_ms: float) -> bool:
+    """One constriction's corrections of the leads and presses ``kn`` (the module's list), from what a round
+    measured of it: (ms late, released early, made before its start, held after its end); whether any moved."""
+    k = g.segment
+    on, off, ahead, held = measured
+    changed = False
+    nxt = k + 1 < len(segs)
+    if not np.isfinite(on):
+        inside = area[(t >= kn.starts[k] / 1e3) & (t < end_ms / 1e3)]
+        if len(inside) and inside.max() <= g.floor_cm2:  # a channel too narrow: earlier and softer
+            changed |= kn.press_less(k)
+            return kn.lead_more(k, LEAD_STEP_MS) or changed
+        changed |= kn.press_more(k)
+        changed |= kn.lead_more(k, LEAD_STEP_MS)
+        if not changed:
+            changed = kn.further(k)
+        if nxt and segs[k + 1].continues:  # nor let its own next part (an affricate's release) cut it short
+            changed |= kn.lead_less(k + 1, LEAD_STEP_MS)
+    elif on > SLACK_MS:
+        changed |= kn.lead_more(k, on) or kn.press_more(k) or kn.further(k, on)
+    if off > SLACK_MS and nxt:
+        changed |= kn.lead_less(k + 1, off)
+    if ahead > EARLY_MS and not segs[k].continues:
+        changed |= kn.lead_less(k, ahead - WINDOW_MS)
+    if held > HELD_MS and nxt and not segs[k + 1].continues:
+        changed |= kn.lead_more(k + 1, held)
+    return changed
 
 
 def missed_ms(goals: list[Goal], late: dict, early: dict, starts: np.ndarray, ends: np.ndarray,
@@ -229,32 +241,6 @@ def missed_ms(goals: list[Goal], late: dict, early: dict, starts: np.ndarray, en
                 share = min(max(gap, 0.0) / (0.5 * (g.floor_cm2 + g.reach_cm2)), 1.0)
         out += span * share
     return float(out)
-
-
-def soften(press: np.ndarray, free: list[bool]) -> bool:
-    """Every free press above 1 a step softer (not below 1); whether any moved."""
-    hard = np.array(free, bool) & (press > 1.0)
-    press[hard] = np.maximum(press[hard] / PRESS_STEP, 1.0)
-    return bool(hard.any())
-
-
-def _in_order(leads: np.ndarray, starts: np.ndarray, free: list[bool]) -> None:
-    """Each free lead cut to switch at least ``MIN_GAP_MS`` after the segment before it (in place)."""
-    for k in range(1, len(leads)):
-        if free[k]:
-            leads[k] = max(min(leads[k], starts[k] - (starts[k - 1] - leads[k - 1]) - MIN_GAP_MS), 0.0)
-
-
-def _lead_more(leads: np.ndarray, starts: np.ndarray, k: int, by_ms: float, free: list[bool]) -> bool:
-    """Segment ``k`` leads ``by_ms`` more, as far as the switch before it and ``LEAD_MAX_MS`` allow."""
-    if not free[k] or k == 0:
-        return False
-    limit = min(LEAD_MAX_MS, starts[k] - (starts[k - 1] - leads[k - 1]) - MIN_GAP_MS)
-    new = min(leads[k] + by_ms, limit)
-    if new <= leads[k] + 0.5:
-        return False
-    leads[k] = new
-    return True
 
 
 def _with(u: Utterance, leads, press) -> Utterance:

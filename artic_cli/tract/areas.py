@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..config import VocalTract
-from ..errors import ArticError
+from ..errors import ArticError, OffGrid
 from .area_function import AreaFunctions, area_functions, segments
 from .band import band_area, band_planes
 from .outline import Grid, inner_polylines, moving_parts
@@ -54,7 +54,7 @@ def tracts_of(vt: VocalTract, cfg_wall, shapes: Shapes, controls: dict[str, np.n
     bad = np.argwhere(np.isnan(af.distance_cm))
     if len(bad):
         fr, k = (int(v) for v in bad[0])
-        raise ArticError(f"frame {fr} (t = {shapes.time_s[fr]:.3f} s): the midline cannot be traced, grid line {k} "
+        raise OffGrid(f"frame {fr} (t = {shapes.time_s[fr]:.3f} s): the midline cannot be traced, grid line {k} "
                          f"({grid.arc_cm[k]:.2f} cm from the glottis) meets no tongue or larynx within "
                          f"{grid.reach_cm:g} cm; the shape left the grid (raise vocal_tract.grid.reach_cm)")
     band, z = None, None

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from artic_cli.speech.timing import onset_and_release, soften
+from artic_cli.speech.leads import soften
+from artic_cli.speech.timing import onset_and_release
 
 T = np.arange(0.0, 0.4, 0.005)
 
@@ -64,7 +65,7 @@ def test_a_closure_made_long_before_its_interval_is_measured_from_its_making():
 
 
 def test_an_unphysical_round_softens_every_free_press_above_one_a_step():
-    from artic_cli.speech.timing import PRESS_STEP
+    from artic_cli.speech.leads import PRESS_STEP
 
     press = np.array([1.0, 1.75, 0.8, 1.1, 2.0])
     assert soften(press, [True, True, True, True, False])
