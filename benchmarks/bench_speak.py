@@ -1,8 +1,11 @@
 """Speed of speaking an utterance once its targets are solved (issue "Utterances").
 
-Goal: simulation plus synthesis of 1 s of speech at most 10 s of wall time on one core.  A 1-s utterance of
-four force sets (/a/, /i/-like, a lip closure, /a/) on the default speaker; prints each part's time: the
-rest posture, the simulation (contact on), the tract and formant tracks, the sound.  Needs only the config.
+Goals: simulation plus synthesis of 1 s of speech at most 10 s of wall time on one core (issue "Utterances"), at
+most 1 s once its targets are solved (issue "Say any Japanese word").  A 1-s utterance of four force sets (/a/,
+/i/-like, a lip closure, /a/) on the default speaker; prints each part's time: the rest posture, the segments'
+EPs, the simulation (contact on), the tract and formant tracks, the sound; and beside it, where it is installed,
+VocalTractLab's own synthesis of 1 s (``synth_block``: 400 tract states gliding from its /a/ to its /i/, the
+modal glottis, 110 samples a state).  Needs only the config.
 """
 
 from __future__ import annotations
@@ -44,6 +47,32 @@ def main() -> None:
           f"{st['wall_time_s']:.1f} s ({st['steps']} steps, {st['newton_iterations']} Newton iterations) "
           f"(goal <= 10 s) -> {'met' if total <= 10.0 else 'NOT MET'}")
     print("  " + "; ".join(f"{name} {t_:.2f} s" for name, t_ in s.timings_s.items()))
+    print(f"1 s of speech once its forces are known: {total:.1f} s (goal <= 1 s) -> "
+          f"{'met' if total <= 1.0 else 'NOT MET'}")
+    vtl = vocaltractlab_seconds()
+    if vtl is None:
+        print("VocalTractLab not installed (pip install vocaltractlab-cython): no side-by-side figure")
+    else:
+        print(f"VocalTractLab, 1 s of speech from 400 tract states (synth_block, median of 3): {vtl:.2f} s; "
+              f"ours / theirs = {total / vtl:.2f}")
+
+
+def vocaltractlab_seconds() -> float | None:
+    """VocalTractLab's wall time (s) to synthesize 1 s from its own tract states, median of 3 (None: absent)."""
+    try:
+        import numpy as np
+        import vocaltractlab_cython as vtl
+    except ImportError:
+        return None
+    a, i, glottis = vtl.get_shape("a", "tract"), vtl.get_shape("i", "tract"), vtl.get_shape("modal", "glottis")
+    w = np.linspace(0.0, 1.0, 400)[:, None]
+    tract, folds = a * (1.0 - w) + i * w, np.tile(glottis, (400, 1))
+    took = []
+    for _ in range(3):
+        t0 = time.perf_counter()
+        vtl.synth_block(tract, folds, state_samples=110)
+        took.append(time.perf_counter() - t0)
+    return float(np.median(took))
 
 
 if __name__ == "__main__":

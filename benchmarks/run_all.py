@@ -21,7 +21,8 @@ BENCHES = [("Tongue alone (section II)", "bench_tissue.py"), ("Whole articulator
            ("Acoustics (tubes)", "bench_acoustics.py"), ("Vocal tract (area functions)", "bench_vocal_tract.py"),
            ("Vowels (acoustic maps, formant targets)", "bench_vowels.py"),
            ("Utterances (simulation and sound of 1 s of speech)", "bench_speak.py"),
-           ("Speaking from text (artic speak --text aga)", "bench_speak_text.py")]
+           ("Speaking from text (artic speak --text aga)", "bench_speak_text.py"),
+           ("Words from text (artic speak --text sayonara)", "bench_speak_words.py")]
 
 
 def main() -> int:

@@ -246,7 +246,7 @@ def formant_tracks(tracts: Tracts, time_s: np.ndarray, cfg: Config) -> np.ndarra
     picked = np.unique(np.r_[np.arange(0, tracts.n_frames, stride), tracts.n_frames - 1])
     tubes = [Tube(tracts.af.length_cm[k], tracts.af.area_cm2[k]) for k in picked]
     ac = analyse(tubes, cfg.acoustics, velum_area_cm2=tracts.controls["velum_port_cm2"][picked],
-                 port_from_glottis_cm=port_positions(tracts)[picked])
+                 port_from_glottis_cm=port_positions(tracts)[picked], spectra=False, bandwidths=False)
     formants_hz = np.stack([np.interp(time_s, time_s[picked], ac.formants_hz[:, j])
                             for j in range(ac.formants_hz.shape[1])], axis=1)
     formants_hz[tracts.af.area_cm2.min(axis=1) <= 0] = np.nan  # a closed tract has none
