@@ -22,10 +22,9 @@ A round whose simulation is not physical (an inverted brick, a tongue off the tr
 presses become their ceilings less a step, and every press above 1 softens a step for the next; so after a round
 faster than a speaker moves (peak speeds beyond the EMA range + 50 %), which counts as missing the share it is
 too fast of every constriction's interval.  Leads keep their bounds (:mod:`.leads`: a segment after a vowel
-switches on no earlier than the vowel's middle until it may press no harder).  The rounds stop
-when nothing moves or every constriction is on time; the round that missed the fewest ms of its constrictions'
-intervals is the one kept (the corrections of a closure and of the channel after it can swing), with what it
-measured.
+switches on no earlier than the vowel's middle until it may press no harder).  The rounds stop when nothing
+moves or every constriction is on time; the round that missed the fewest ms of its constrictions' intervals is
+the one kept (the corrections of a closure and of the channel after it can swing), with what it measured.
 """
 
 from __future__ import annotations
