@@ -32,10 +32,20 @@ def parallel_backend(backend: str, jobs: int, scheduler: str | None) -> Iterator
         return
     if backend != "dask":
         raise ArticError(f"unknown --backend '{backend}'; valid: loky, dask")
+    with dask_client(jobs, scheduler):
+        with parallel_config(backend="dask", n_jobs=-1):
+            yield
+
+
+@contextlib.contextmanager
+def dask_client(jobs: int, scheduler: str | None, hint: str = "or use --backend loky") -> Iterator:
+    """A dask.distributed client: of the cluster at ``scheduler``, or of a LocalCluster of ``jobs`` worker
+    processes (one thread each) over loopback; closed (the local cluster shut down) on the way out."""
+    check_number("--jobs", jobs, ge=1)
     try:
         from dask.distributed import Client, LocalCluster
     except ImportError:  # pragma: no cover - distributed is a dependency
-        raise ArticError("--backend dask needs dask.distributed; pip install distributed") from None
+        raise ArticError("dask.distributed is missing; pip install distributed") from None
     cluster = None
     try:
         if scheduler:
@@ -46,10 +56,9 @@ def parallel_backend(backend: str, jobs: int, scheduler: str | None) -> Iterator
             client = Client(cluster)
     except (OSError, TimeoutError) as err:
         raise ArticError(f"cannot reach the dask scheduler at {scheduler}: {type(err).__name__}; start one "
-                         "('dask scheduler') or use --backend loky") from None
+                         f"('dask scheduler') {hint}") from None
     try:
-        with parallel_config(backend="dask", n_jobs=-1):
-            yield
+        yield client
     finally:
         client.close()
         if cluster is not None:

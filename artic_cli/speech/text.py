@@ -41,8 +41,9 @@ def _ascii(w: Word) -> str:
                    for k, lab in enumerate(labels))
 
 
-def phrases_of(text: str, inv: Inventory) -> list[list[Word]]:
-    """The text's phrases (parted by ','), each its words with their devoiced morae marked; every limit checked."""
+def phrases_of(text: str, inv: Inventory, accent: int | None = None) -> list[list[Word]]:
+    """The text's phrases (parted by ','), each its words with their devoiced morae marked; every limit checked.
+    ``accent``: the mora a one-word text's pitch falls after (0: unaccented), for a text without a mark."""
     out: list[list[Word]] = [[]]
     for w in words(text):
         if w is None:
@@ -55,6 +56,8 @@ def phrases_of(text: str, inv: Inventory) -> list[list[Word]]:
     n = sum(len(w.morae) for p in out for w in p)
     if n > MAX_MORAE:
         raise ArticError(f"--text: {n} morae is more than the {MAX_MORAE} spoken at once; split the text")
+    if accent is not None:
+        _set_accent(out, accent)
     for p in out:
         morae = [m for w in p for m in w.morae]
         starts = [0]
@@ -65,8 +68,19 @@ def phrases_of(text: str, inv: Inventory) -> list[list[Word]]:
     return out
 
 
+def _set_accent(phrases: list[list[Word]], accent: int) -> None:
+    ws = [w for p in phrases for w in p]
+    if len(ws) != 1 or ws[0].accent is not None:
+        raise ArticError(f"accent {accent}: an accent column is for one word without an accent mark; mark the "
+                         "accents in the text instead (e.g. ha'shi)")
+    if accent > len(ws[0].morae):
+        raise ArticError(f"accent {accent}: '{ws[0].text}' has {len(ws[0].morae)} morae; give 0 (unaccented) to "
+                         f"{len(ws[0].morae)}")
+    ws[0].accent = accent or None
+
+
 def utterance_of_text(text: str, inv: Inventory, name: str | None = None, rate: float = 1.0,
-                      f0_range_hz: tuple[float, float] | None = None) -> Utterance:
+                      f0_range_hz: tuple[float, float] | None = None, accent: int | None = None) -> Utterance:
     """The text as an utterance: each phone of its morae a phoneme segment at its mora-timed duration, a pause a
     silent segment (the glottis shut), the F0 from its accents, its morae and words as tiers."""
     if not RATES[0] <= rate <= RATES[1]:
@@ -78,7 +92,7 @@ def utterance_of_text(text: str, inv: Inventory, name: str | None = None, rate: 
     segments: list[dict] = []
     morae_tier, words_tier, timed = [], [], []
     t = 0.0
-    phrases = phrases_of(text, inv)
+    phrases = phrases_of(text, inv, accent)
     for n, phrase in enumerate(phrases):
         if n:
             d = inv.timing.pause_ms / rate

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..config import load_config
+from ..config import DEFAULT_CONFIG, load_config
 from ..control.solver import TargetSpec
 from ..control.targets import batch_csv, load_target, read_batch
 from ..control.targets import solve_batch as solve_rows
@@ -18,7 +18,7 @@ from ..io.fingerprint import digest
 from ..io.store import write_text_atomic
 from ..speech.plan import Answer
 from ..validation import check_number
-from . import paths
+from . import loaded, paths
 from .solve import add_formants, load_context, read, simulator, solve_target
 
 
@@ -58,24 +58,37 @@ def _solve_here(targets: list[TargetSpec], maps, mesh, acoustic_maps, config, fo
                 dynamic: str | None) -> list[Answer]:
     if not targets:
         return []
-    ctx = load_context(maps, dynamic, mesh)
-    sim = voicer = None
-    if any(t.needs_tract for t in targets):
-        add_formants(ctx, maps, mesh, config, acoustic_maps)
-        voicer = simulator(mesh, config, voiced=True)
-    if any(not t.needs_tract for t in targets):
-        sim = voicer.sim if voicer is not None else simulator(mesh, config)
-    mesh_sha = (voicer.sim if voicer is not None else sim).mesh_sha256
+    tract = any(t.needs_tract for t in targets)
+    files = (maps, dynamic, mesh, acoustic_maps, config or DEFAULT_CONFIG)
+    ctx = loaded.once("solve-context", lambda: _context(maps, dynamic, mesh, acoustic_maps, config, tract),
+                      files, (tract,))
+    voicer = loaded.once("voicer", lambda: simulator(mesh, config, voiced=True), files[2:]) if tract else None
+    sim = voicer.sim if voicer is not None else loaded.once("simulator", lambda: simulator(mesh, config), files[2:])
     out = []
     for t in targets:
         path = solution_path(folder, t)
         try:
-            doc, path, _ = solve_target(t, ctx, path, voicer if t.needs_tract else sim, False, True, budget,
-                                        config, mesh_sha)
+            with _solving(path):  # another worker solving the same target: wait for its answer and read it
+                doc, path, _ = solve_target(t, ctx, path, voicer if t.needs_tract else sim, False, True, budget,
+                                            config, sim.mesh_sha256)
             out.append(Answer(doc, path))
         except UnreachableTarget as err:
             out.append(Answer(read(path) if path.is_file() else None, path, err))
     return out
+
+
+def _context(maps, dynamic, mesh, acoustic_maps, config, tract: bool):
+    ctx = load_context(maps, dynamic, mesh)
+    return add_formants(ctx, maps, mesh, config, acoustic_maps) if tract else ctx
+
+
+def _solving(path: Path):
+    """A lock on one answer's file (in the folder's ``.locks``), held while it is solved."""
+    from filelock import FileLock
+
+    locks = path.parent / ".locks"
+    locks.mkdir(parents=True, exist_ok=True)
+    return FileLock(locks / f"{path.name}.lock")
 
 
 @dataclass

@@ -17,7 +17,7 @@ from typing import Callable
 import numpy as np
 
 from .. import units
-from ..config import Config, load_config
+from ..config import DEFAULT_CONFIG, Config, load_config
 from ..errors import ArticError
 from ..io.fingerprint import digest
 from ..io.store import atomic_h5, open_artifact, stored_content_hash
@@ -36,7 +36,7 @@ from ..speech.utterance import Utterance, check_forces, load_utterance
 from ..tract.places import section_places
 from ..tract.speaker import speaker_tract
 from . import mesh as mesh_stage
-from . import paths
+from . import loaded, paths
 from . import simulate as sim_stage
 from . import solve_runs
 from .base import Stage, up_to_date
@@ -86,7 +86,9 @@ def write(wav: Path | str, s: Spoken, prov=None) -> dict[str, Path]:
         g.create_dataset("duration", data=p.durations_s).attrs["units"] = "s"
         g.create_dataset("voiced", data=p.voiced)
         g.create_dataset("how", data=np.array(p.notes, dtype="S"))
-        g.create_dataset("solution", data=np.array(p.solutions, dtype="S"))
+        # the answers' file names in the solutions folder (not its path: the same utterance is the same record
+        # wherever it is spoken)
+        g.create_dataset("solution", data=np.array([Path(f_).name for f_ in p.solutions], dtype="S"))
         g.create_dataset("ep", data=s.segment_eps_cm).attrs["units"] = ("cm: tip, dorsum, jaw where each segment's "
                                                                         "forces lead (held from rest, jaw free)")
         g.attrs["force_course"] = s.force_course
@@ -236,7 +238,7 @@ def speak(utterance: Path | str | Utterance, out: Path | str | None = None, maps
     files = {"wav": out, "textgrid": textgrid_path(out), "h5": h5_path(out)}
     if up_to_date(files["h5"], prov) and files["wav"].is_file() and files["textgrid"].is_file():
         return SpeakResult(files, None, up_to_date=True)
-    model = sim_stage.build(cfg, m.mesh, m.wall)
+    model = loaded.once("articulator", lambda: sim_stage.build(cfg, m.mesh, m.wall), (mesh, config or DEFAULT_CONFIG))
     check_forces(u, list(model.drivable()), str(source or u.name))
     solve = partial(solve_on, dynamic=dynamic if dynamic is not None and needs_dynamic(targets, cfg) else None)
     view = STAGE.view(cfg)
