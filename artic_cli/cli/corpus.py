@@ -36,6 +36,8 @@ def corpus_cmd(
     config: Optional[Path] = typer.Option(None, "--config", help="Config of every item without its own."),
     inventory: Optional[Path] = typer.Option(None, "--inventory", help="Phoneme inventory (default "
                                                                        "configs/phonemes/japanese.yaml)."),
+    solutions: Optional[Path] = typer.Option(None, "--solutions", help="Where the targets' answers are kept "
+                                             "(default: DIR/solutions); corpora may share one."),
     budget: int = typer.Option(8, "--budget", help="Most simulations each target's refinement may spend."),
 ):
     """Speak every item of LIST into --out, on a dask.distributed cluster: each item's WAV, TextGrid, HDF5
@@ -49,7 +51,8 @@ def corpus_cmd(
         raise ArticError(f"--out {out} is a file; give a folder")
     ab = lambda p: None if p is None else str(Path(p).absolute())  # noqa: E731 - the workers' paths
     setup = Setup(maps=ab(maps), mesh=ab(mesh), acoustic_maps=ab(acoustic_maps), dynamic=ab(dynamic),
-                  config=ab(config), inventory=ab(inventory), budget=budget)
+                  config=ab(config), inventory=ab(inventory), budget=budget,
+                  solutions=ab(solutions))
     say = lambda m: err_console.print(m, highlight=False, soft_wrap=True)  # noqa: E731
     start = time.perf_counter()
     bar, update = _progress()
@@ -61,7 +64,7 @@ def corpus_cmd(
                 res = run_corpus(listing, out, setup, jobs, scheduler, update, say)
     except KeyboardInterrupt:
         err_console.print(f"interrupted; the finished items are in {out / 'index.csv'}, run the same command "
-                          "again to go on")
+                          "again to go on", highlight=False, soft_wrap=True)
         raise typer.Exit(130) from None
     ok = len(res.rows) - len(res.failed)
     out_console.print(f"{out}: {ok} of {len(res.rows)} items spoken ({res.spoken} this run, {res.kept} already "

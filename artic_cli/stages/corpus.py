@@ -45,6 +45,7 @@ class Setup:
     config: str | None = None
     inventory: str | None = None
     budget: int = 8
+    solutions: str | None = None  # where the targets' answers are kept (default: the corpus's solutions/)
 
     def shared(self) -> dict:
         """The content of what every item's recipe shares (the code, the artefacts, the configs)."""
@@ -107,7 +108,7 @@ def _spoken(item: Item, setup: Setup, out: Path) -> dict:
     items = out / "items"
     items.mkdir(parents=True, exist_ok=True)
     res = speak_stage.speak(u, items / f"{item.id}.wav", setup.maps, setup.mesh, setup.acoustic_maps,
-                            item.config or setup.config, out / "solutions", False, setup.budget,
+                            item.config or setup.config, setup.solutions or out / "solutions", False, setup.budget,
                             dynamic=setup.dynamic, inventory=setup.inventory)
     rec = speak_stage.read(res.paths["h5"])
     ema = items / f"{item.id}.ema.csv"
@@ -169,6 +170,10 @@ def run_corpus(listing: Path | str, out: Path | str, setup: Setup = Setup(), job
     old = read_index(out)
     rows = {it.id: old[it.id] for it in items if finished(out, old.get(it.id), keys[it.id])}
     todo = [it for it in items if it.id not in rows]
+    for it in todo:  # a spoken item whose files changed or went since: its files go, so it is spoken again
+        was = old.get(it.id)
+        if was is not None and was.get("recipe_sha256") == keys[it.id] and was.get("status") == "ok":
+            _remove(out, it.id)
     res = CorpusResult(rows=[], kept=len(rows))
     out.mkdir(parents=True, exist_ok=True)
     order = [it.id for it in items]
