@@ -22,7 +22,8 @@ BENCHES = [("Tongue alone (section II)", "bench_tissue.py"), ("Whole articulator
            ("Vowels (acoustic maps, formant targets)", "bench_vowels.py"),
            ("Utterances (simulation and sound of 1 s of speech)", "bench_speak.py"),
            ("Speaking from text (artic speak --text aga)", "bench_speak_text.py"),
-           ("Words from text (artic speak --text sayonara)", "bench_speak_words.py")]
+           ("Words from text (artic speak --text sayonara)", "bench_speak_words.py"),
+           ("Corpora (artic corpus on dask.distributed)", "bench_corpus.py")]
 
 
 def main() -> int:

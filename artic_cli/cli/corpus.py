@@ -39,6 +39,8 @@ def corpus_cmd(
     solutions: Optional[Path] = typer.Option(None, "--solutions", help="Where the targets' answers are kept "
                                              "(default: DIR/solutions); corpora may share one."),
     budget: int = typer.Option(8, "--budget", help="Most simulations each target's refinement may spend."),
+    accept_nearest: bool = typer.Option(False, "--accept-nearest", help="Speak an unreachable target's nearest "
+                                        "answer instead of recording the item as unreachable."),
 ):
     """Speak every item of LIST into --out, on a dask.distributed cluster: each item's WAV, TextGrid, HDF5
     record and EMA CSV, one row of the index per item.  Run again, it speaks only what is not done (an
@@ -52,7 +54,7 @@ def corpus_cmd(
     ab = lambda p: None if p is None else str(Path(p).absolute())  # noqa: E731 - the workers' paths
     setup = Setup(maps=ab(maps), mesh=ab(mesh), acoustic_maps=ab(acoustic_maps), dynamic=ab(dynamic),
                   config=ab(config), inventory=ab(inventory), budget=budget,
-                  solutions=ab(solutions))
+                  solutions=ab(solutions), accept_nearest=accept_nearest)
     say = lambda m: err_console.print(m, highlight=False, soft_wrap=True)  # noqa: E731
     start = time.perf_counter()
     bar, update = _progress()
@@ -69,7 +71,9 @@ def corpus_cmd(
     ok = len(res.rows) - len(res.failed)
     out_console.print(f"{out}: {ok} of {len(res.rows)} items spoken ({res.spoken} this run, {res.kept} already "
                       f"done), {len(res.failed)} not; index {out / 'index.csv'}, card {out / 'README.md'} "
-                      f"({time.perf_counter() - start:.1f} s)", highlight=False)
+                      f"({time.perf_counter() - start:.1f} s"
+                      + (f"; peak memory per worker {max(res.peak_mb.values()):.0f} MB" if res.peak_mb else "") + ")",
+                      highlight=False)
     if res.failed:
         raise typer.Exit(3)
 

@@ -11,6 +11,7 @@ unreachable target) is recorded with its error while the rest go on.
 
 from __future__ import annotations
 
+import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -46,6 +47,7 @@ class Setup:
     inventory: str | None = None
     budget: int = 8
     solutions: str | None = None  # where the targets' answers are kept (default: the corpus's solutions/)
+    accept_nearest: bool = False  # an unreachable target's nearest answer spoken (else the item is unreachable)
 
     def shared(self) -> dict:
         """The content of what every item's recipe shares (the code, the artefacts, the configs)."""
@@ -60,7 +62,8 @@ class Setup:
                 "acoustic_maps": None if self.acoustic_maps is None else stored_content_hash(self.acoustic_maps),
                 "dynamic": None if self.dynamic is None else stored_content_hash(self.dynamic),
                 "config": file_hash(self.config or DEFAULT_CONFIG),
-                "inventory": file_hash(self.inventory or DEFAULT), "budget": self.budget}
+                "inventory": file_hash(self.inventory or DEFAULT), "budget": self.budget,
+                **({"accept_nearest": True} if self.accept_nearest else {})}
 
 
 def recipe(item: Item, shared: dict) -> str:
@@ -83,7 +86,14 @@ def speak_item(item: Item, setup: Setup, out: str, key: str) -> dict:
         _remove(Path(out), item.id)
         row.update(_failure(err))
     row["wall_s"] = round(time.perf_counter() - t0, 2)
+    row["worker"] = (os.getpid(), _peak_mb())
     return row
+
+
+def _peak_mb() -> float:
+    import resource
+
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0  # kB on Linux
 
 
 def _failure(err: BaseException) -> dict:
@@ -108,7 +118,7 @@ def _spoken(item: Item, setup: Setup, out: Path) -> dict:
     items = out / "items"
     items.mkdir(parents=True, exist_ok=True)
     res = speak_stage.speak(u, items / f"{item.id}.wav", setup.maps, setup.mesh, setup.acoustic_maps,
-                            item.config or setup.config, setup.solutions or out / "solutions", False, setup.budget,
+                            item.config or setup.config, setup.solutions or out / "solutions", setup.accept_nearest, setup.budget,
                             dynamic=setup.dynamic, inventory=setup.inventory)
     rec = speak_stage.read(res.paths["h5"])
     ema = items / f"{item.id}.ema.csv"
@@ -155,6 +165,7 @@ class CorpusResult:
     spoken: int = 0  # items simulated in this run
     kept: int = 0  # items already done (their rows kept)
     failed: list[dict] = field(default_factory=list)  # rows not ok
+    peak_mb: dict[int, float] = field(default_factory=dict)  # each worker's (pid) peak resident memory, MB
     interrupted: bool = False
 
 
@@ -213,6 +224,9 @@ def _run(todo: list[Item], setup: Setup, out: Path, keys: dict, jobs: int, sched
                 row = {**it.as_dict(), "recipe_sha256": keys[it.id], **_failure(err), "wall_s": None}
                 row.pop("config")
             res.spoken += bool(row.pop("spoke", False))
+            pid, mb = row.pop("worker", (None, 0.0))
+            if pid is not None:
+                res.peak_mb[pid] = max(res.peak_mb.get(pid, 0.0), mb)
             rows[it.id] = row
             write_index(out, [rows[i] for i in order if i in rows])
             if say and row["status"] != "ok":
@@ -229,7 +243,8 @@ def _facts(listing, setup: Setup, shared: dict) -> dict:
             "mesh content sha256": shared["mesh"], "EP maps content sha256": shared["epmaps"],
             "acoustic maps content sha256": shared["acoustic_maps"], "dynamic map content sha256": shared["dynamic"],
             "inventory sha256": shared["inventory"], "list": str(listing), "list sha256": file_hash(listing),
-            "refinement budget (simulations per target)": setup.budget}
+            "refinement budget (simulations per target)": setup.budget,
+            "unreachable targets": "their nearest answers spoken" if setup.accept_nearest else "the item not spoken"}
 
 
 def _symbols(setup: Setup) -> list[str]:
