@@ -187,6 +187,20 @@ def test_a_worker_killed_mid_run_has_its_item_spoken_elsewhere(corpus_setup):
     assert [r["status"] for r in res.rows] == ["ok"] * 6, [r.get("error") for r in res.rows]
 
 
+def test_a_corpus_runs_on_an_existing_cluster_given_its_scheduler_address(corpus_setup, spoken):
+    from dask.distributed import LocalCluster
+
+    tmp, setup = corpus_setup
+    (tmp / "two.tsv").write_text("x1\taka\nx2\tpapa\n")
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, host="127.0.0.1",
+                      dashboard_address=None) as cluster:
+        res = run_corpus(tmp / "two.tsv", tmp / "remote", setup, scheduler=cluster.scheduler_address)
+        pids = {p.pid for p in _workers()}
+    assert [r["status"] for r in res.rows] == ["ok", "ok"] and set(res.peak_mb) == pids  # spoken on its worker
+    one = {r["id"]: r for r in _rows(spoken[0])}
+    assert res.rows[0]["wav_sha256"] == one["w05"]["wav_sha256"]  # the same text, the same sound
+
+
 def test_the_list_s_form_is_checked_on_load_with_one_line(tmp_path):
     cases = {"dup.tsv": ("a\taka\na\tiki\n", "id 'a' is already used on line 1"),
              "name.tsv": ("../x\taka\n", "cannot be a file name"),
