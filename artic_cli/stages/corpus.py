@@ -104,6 +104,7 @@ def _failure(err: BaseException) -> dict:
     else:  # a crash: tried again on the next run
         status, code = "failed", 1
     text = str(err) if isinstance(err, ArticError) else f"{type(err).__name__}: {err}"
+    text = text.removeprefix("--text: ")  # the item's text, not a command-line option, is what it names
     return {"status": status, "exit_code": code, "error": " ".join(text.split())[:500], "spoke": False}
 
 
