@@ -249,3 +249,20 @@ def test_bad_corpus_input_is_one_line_and_exit_2(tmp_path, monkeypatch, args, sa
     res = run_cli("corpus", *args, "--out", tmp_path / "out")
     assert res.exit_code == 2 and says in res.output and len(res.output.strip().splitlines()) == 1, res.output
     assert not (tmp_path / "out").exists()
+
+
+def test_a_worker_keeps_what_it_loaded_until_the_file_changes(tmp_path):
+    from artic_cli.stages import loaded
+
+    f = tmp_path / "maps.h5"
+    f.write_bytes(b"one")
+    made = []
+    make = lambda: made.append(1) or object()  # noqa: E731
+    a = loaded.once("test", make, (f, None))
+    assert loaded.once("test", make, (f, None)) is a and len(made) == 1  # loaded once
+    f.write_bytes(b"other content")
+    assert loaded.once("test", make, (f, None)) is not a and len(made) == 2  # the file changed: loaded again
+    for k in range(loaded.KEEP + 1):
+        loaded.once("test", make, (tmp_path / f"m{k}", None))
+    assert len(loaded._kept["test"]) == loaded.KEEP  # the oldest dropped
+    loaded.forget()
