@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-from scipy.signal import welch
 
 
 def band_level_db(samples: np.ndarray, rate_hz: int, t0_s: float, t1_s: float, lo_hz: float = 0.0,
@@ -31,6 +30,8 @@ def band_power_db(x: np.ndarray, rate: int, t0: float, t1: float, lo: float = 0.
     if lo <= 0 and hi is None:
         power = float(np.mean(seg ** 2))
     else:
+        from scipy.signal import welch  # here: scipy.signal takes 0.5 s to import, and speaking needs it not
+
         f, pxx = welch(seg, rate, nperseg=min(512, len(seg)), noverlap=None, detrend=False)
         keep = (f >= lo) & (f < (hi if hi is not None else np.inf))
         power = float(np.sum(pxx[keep]) * (f[1] - f[0]))
