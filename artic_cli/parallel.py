@@ -9,6 +9,7 @@ the key: the caller puts what they depend on (content hashes) into the key argum
 from __future__ import annotations
 
 import contextlib
+import logging
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Iterator, Sequence
@@ -51,8 +52,10 @@ def dask_client(jobs: int, scheduler: str | None, hint: str = "or use --backend 
         if scheduler:
             client = Client(scheduler, timeout="10s")
         else:
+            # the workers' own log lines (a cancelled task on Ctrl-C, a restarted worker) at ERROR only: what a
+            # user needs of them is in the caller's progress, errors and index
             cluster = LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, host="127.0.0.1",
-                                   dashboard_address=None)
+                                   dashboard_address=None, silence_logs=logging.ERROR)
             client = Client(cluster)
     except (OSError, TimeoutError) as err:
         raise ArticError(f"cannot reach the dask scheduler at {scheduler}: {type(err).__name__}; start one "
