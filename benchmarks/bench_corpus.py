@@ -29,8 +29,8 @@ def run(listing: Path, out: Path, solutions: Path, jobs: int):
     from artic_cli.stages.corpus import Setup, run_corpus
 
     data = ROOT / "data"
-    setup = Setup(maps=str(data / "epmaps.h5"), mesh=str(data / "mesh.h5"), acoustic_maps=str(data / "acoustic_maps.h5"),
-                  dynamic=str(data / "dynamic.h5"), solutions=str(solutions), accept_nearest=True)
+    setup = Setup(maps=str(data / "epmaps.h5"), mesh=str(data / "mesh.h5"),
+                  acoustic_maps=str(data / "acoustic_maps.h5"), dynamic=str(data / "dynamic.h5"), solutions=str(solutions), accept_nearest=True)
     t0 = time.perf_counter()
     res = run_corpus(listing, out, setup, jobs=jobs)
     return time.perf_counter() - t0, res

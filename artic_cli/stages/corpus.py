@@ -77,8 +77,7 @@ def speak_item(item: Item, setup: Setup, out: str, key: str) -> dict:
     """Speak one item into ``out/items``: its index row (status, error, files, hashes, wall time) and whether
     it was simulated (``spoke``: False when its files already held this recipe)."""
     t0 = time.perf_counter()
-    row = {**item.as_dict(), "recipe_sha256": key}
-    row.pop("config")
+    row = _row(item, key)
     try:
         row.update(_spoken(item, setup, Path(out)))
         row.update(status="ok", exit_code=0, error=None)
@@ -88,6 +87,11 @@ def speak_item(item: Item, setup: Setup, out: str, key: str) -> dict:
     row["wall_s"] = round(time.perf_counter() - t0, 2)
     row["worker"] = (os.getpid(), _peak_mb())
     return row
+
+
+def _row(item: Item, key: str) -> dict:
+    """An item's index row as the list gives it (its config is part of the recipe, not a column)."""
+    return {"id": item.id, "text": item.text, "rate": item.rate, "accent": item.accent, "recipe_sha256": key}
 
 
 def _peak_mb() -> float:
@@ -119,8 +123,8 @@ def _spoken(item: Item, setup: Setup, out: Path) -> dict:
     items = out / "items"
     items.mkdir(parents=True, exist_ok=True)
     res = speak_stage.speak(u, items / f"{item.id}.wav", setup.maps, setup.mesh, setup.acoustic_maps,
-                            item.config or setup.config, setup.solutions or out / "solutions", setup.accept_nearest, setup.budget,
-                            dynamic=setup.dynamic, inventory=setup.inventory)
+                            item.config or setup.config, setup.solutions or out / "solutions", setup.accept_nearest,
+                            setup.budget, dynamic=setup.dynamic, inventory=setup.inventory)
     rec = speak_stage.read(res.paths["h5"])
     ema = items / f"{item.id}.ema.csv"
     write_text_atomic(ema, ema_csv(rec.time_s, _points(rec, setup, item), *_lips(res.paths["h5"])))
@@ -129,8 +133,9 @@ def _spoken(item: Item, setup: Setup, out: Path) -> dict:
     from ..io.wav import read_wav
 
     _, rate = read_wav(res.paths["wav"])
-    return {"phones": " ".join(lab or "_" for lab in rec.labels), "duration_s": round(float(rec.attrs["duration_s"]), 4),
-            "sample_rate_hz": int(rate), **files, **item_hashes(out, files), "spoke": not res.up_to_date}
+    return {"phones": " ".join(lab or "_" for lab in rec.labels),
+            "duration_s": round(float(rec.attrs["duration_s"]), 4), "sample_rate_hz": int(rate), **files,
+            **item_hashes(out, files), "spoke": not res.up_to_date}
 
 
 def _points(rec, setup: Setup, item: Item) -> dict[str, np.ndarray]:
@@ -222,8 +227,7 @@ def _run(todo: list[Item], setup: Setup, out: Path, keys: dict, jobs: int, sched
             try:
                 row = fut.result()
             except Exception as err:  # noqa: BLE001 - a lost worker (KilledWorker) or a task that cannot run
-                row = {**it.as_dict(), "recipe_sha256": keys[it.id], **_failure(err), "wall_s": None}
-                row.pop("config")
+                row = {**_row(it, keys[it.id]), **_failure(err), "wall_s": None}
             res.spoken += bool(row.pop("spoke", False))
             pid, mb = row.pop("worker", (None, 0.0))
             if pid is not None:
