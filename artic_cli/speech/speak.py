@@ -79,9 +79,10 @@ class Course:
     duration_s: float  # of the sound
 
 
-def equilibria(model: Model, rest, vectors: np.ndarray, hold_s: float, dt_s: float) -> np.ndarray:
+def equilibria(model: Model, rest, vectors: np.ndarray, hold_s: float, dt_s: float, known=None) -> np.ndarray:
     """(K, 3, 3) tip, dorsum and jaw (cm) after holding each segment's forces ``hold_s`` from the rest posture
-    with the jaw free: where its static forces take the articulators (NaN when ``hold_s`` is 0)."""
+    with the jaw free: where its static forces take the articulators (NaN when ``hold_s`` is 0).  ``known``: a
+    cache of earlier answers for this model and rest posture (``get(key)``, ``put(key, arrays)``), if any."""
     out = np.full((len(vectors), 3, 3), np.nan)
     if hold_s <= 0:
         return out
@@ -89,10 +90,18 @@ def equilibria(model: Model, rest, vectors: np.ndarray, hold_s: float, dt_s: flo
     zero = np.zeros((model.n_nodes, 3))
     seen: dict[bytes, np.ndarray] = {}
     for k, v in enumerate(vectors):
-        key = np.round(v, 6).tobytes()
+        rounded = np.round(v, 6)
+        key = rounded.tobytes()
         if key not in seen:
-            _, end = run(model, rest, lambda t, v=v: Control(node_force=zero, muscle_force=v), hold_s, dt_s)
-            seen[key] = np.array([end.x[pts[n]] for n in ("tip", "dorsum", "jaw")])
+            name = {"forces_dyn": rounded, "hold_s": hold_s, "dt_s": dt_s}
+            hit = known.get(name) if known is not None else None
+            if hit is not None and hit.get("ep_cm", np.zeros(0)).shape == (3, 3):
+                seen[key] = hit["ep_cm"]
+            else:
+                _, end = run(model, rest, lambda t, v=v: Control(node_force=zero, muscle_force=v), hold_s, dt_s)
+                seen[key] = np.array([end.x[pts[n]] for n in ("tip", "dorsum", "jaw")])
+                if known is not None:
+                    known.put(name, {"ep_cm": seen[key]})
         out[k] = seen[key]
     return out
 
@@ -194,16 +203,17 @@ def course_trajectory(model: Model, c: Course, cfg: Config, rest, progress=None,
     return traj
 
 
-def move(model: Model, c: Course, cfg: Config, lap: Laps, progress=None, rest=None, simulated=None
+def move(model: Model, c: Course, cfg: Config, lap: Laps, progress=None, rest=None, simulated=None, known=None
          ) -> tuple[Trajectory, np.ndarray, float]:
     """The course simulated from the rest posture (``rest``, settled here if not given; ``simulated``: its
     trajectory, if already simulated): the trajectory (its clock at the sound's start), where each segment's
-    forces lead (cm) and how far any node got beyond the wall (cm)."""
+    forces lead (cm; ``known``: a cache of them, :func:`equilibria`) and how far any node got beyond the wall
+    (cm)."""
     sp = cfg.speech
     rest = settle(model) if rest is None else rest
     lap("rest posture")
     dt = units.ms_to_s(cfg.simulation.dt_ms)
-    eps = equilibria(model, rest, c.vectors, units.ms_to_s(sp.reach_hold_ms), dt)
+    eps = equilibria(model, rest, c.vectors, units.ms_to_s(sp.reach_hold_ms), dt, known)
     lap("segment EPs")
     traj = course_trajectory(model, c, cfg, rest, progress, lap) if simulated is None else simulated
     lap("simulation")
@@ -274,13 +284,14 @@ def sound(u: Utterance, p: Plan, tracts: Tracts, time_s: np.ndarray, duration_s:
     return out.audio, tb, glottis, air
 
 
-def speak_plan(u: Utterance, p: Plan, cfg: Config, model: Model, progress=None, rest=None, simulated=None
-               ) -> Spoken:
+def speak_plan(u: Utterance, p: Plan, cfg: Config, model: Model, progress=None, rest=None, simulated=None,
+               known=None) -> Spoken:
     """Simulate the plan's force course on ``model`` from the rest posture (``rest``, if settled already;
-    ``simulated``: the course's trajectory from it, if simulated already) and voice it."""
+    ``simulated``: the course's trajectory from it, if simulated already; ``known``: a cache of where held
+    forces lead, :func:`equilibria`) and voice it."""
     c = force_course(u, p, model, cfg)
     lap = Laps()
-    traj, eps, beyond = move(model, c, cfg, lap, progress, rest, simulated)
+    traj, eps, beyond = move(model, c, cfg, lap, progress, rest, simulated, known)
     bad = problems(traj, model.volume_constraint)
     if bad:
         raise NotPhysical(f"utterance '{u.name}': the simulation is not physical ({'; '.join(bad)}); nothing written")

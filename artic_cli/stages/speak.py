@@ -19,10 +19,11 @@ import numpy as np
 from .. import units
 from ..config import DEFAULT_CONFIG, Config, load_config
 from ..errors import ArticError
-from ..io.fingerprint import digest
+from ..io.array_cache import ArrayCache
+from ..io.fingerprint import code_hash, digest
 from ..io.store import atomic_h5, open_artifact, stored_content_hash
 from ..io.wav import write_wav
-from ..mechanics.model import ARTICULATOR_SECTIONS
+from ..mechanics.model import ARTICULATOR_SECTIONS, State
 from ..mechanics.simulate import settle
 from ..speech.plan import Plan, needs_dynamic, plan, segment_targets
 from ..speech.record import Record
@@ -41,6 +42,7 @@ from . import simulate as sim_stage
 from . import solve_runs
 from .base import Stage, up_to_date
 
+CACHE = "cache"  # beside the solutions: the rest posture and where each set of held forces leads
 STAGE = Stage(name="utterances", module=__name__,
               sections=(*ARTICULATOR_SECTIONS, "epmap", "solver", "vocal_tract", "acoustics", "speech"),
               reads=("mesh", "epmaps", "acousticmaps"), kind="utterance", hint="rerun 'artic speak UTTERANCE.yaml'")
@@ -243,10 +245,25 @@ def speak(utterance: Path | str | Utterance, out: Path | str | None = None, maps
     solve = partial(solve_on, dynamic=dynamic if dynamic is not None and needs_dynamic(targets, cfg) else None)
     view = STAGE.view(cfg)
     p = plan(u, view, targets, solve, accept_nearest, say)
-    rest = settle(model)
+    scope = {"articulator": sim_stage.STAGE.provenance(cfg, inputs={"mesh": m.content_sha256}).recipe,
+             "code": code_hash("artic_cli.speech.speak")}  # what the rest posture and the held forces' ends hang on
+    rest = rest_posture(model, ArrayCache(folder / CACHE, "rest", scope))
     u, timing = timed(u, p, view, model, rest, targets)
     if timing is not None and say:
         say(f"timing: {timing.rounds} round(s); leads {', '.join(f'{v:.0f}' for v in timing.leads_ms)} ms; "
             f"presses {', '.join(f'{v:.2f}' for v in timing.press)}")
-    s = speak_plan(u, p, view, model, progress, rest, timing.trajectory if timing is not None else None)
+    s = speak_plan(u, p, view, model, progress, rest, timing.trajectory if timing is not None else None,
+                   ArrayCache(folder / CACHE, "ep", scope))
     return SpeakResult(write(out, s, prov), s)
+
+
+def rest_posture(model, cache: ArrayCache) -> State:
+    """The model's rest posture (:func:`settle`), kept in ``cache`` (its scope: the model's recipe)."""
+    hit = cache.get("rest posture")
+    if hit is not None and hit.get("x", np.zeros(0)).shape == (model.n_nodes, 3):
+        return State(t=0.0, x=hit["x"], v=np.zeros_like(hit["x"]), sigma2=hit.get("sigma2"),
+                     fibre_strain=hit.get("fibre_strain"))
+    rest = settle(model)
+    cache.put("rest posture", {k: v for k, v in (("x", rest.x), ("sigma2", rest.sigma2),
+                                                 ("fibre_strain", rest.fibre_strain)) if v is not None})
+    return rest

@@ -125,6 +125,26 @@ def test_a_spoken_sequence_writes_its_sound_textgrid_and_record(spoken, mesh_fil
     assert parselmouth.praat.call(grid, "Get number of intervals", 1) == 6
 
 
+def test_the_rest_posture_and_held_forces_are_kept_and_give_the_same_record(spoken, mesh_file):
+    """A second speaking reads the rest posture and each set of held forces' end from the cache beside the
+    solutions, and writes the same record; a damaged entry is made again."""
+    cache = spoken / "solutions" / speak.CACHE
+    kept = sorted(p.name for p in cache.glob("*.npz"))
+    first = speak.read(spoken / "lab.h5")
+    distinct = len(np.unique(first.eps_cm.reshape(len(first.labels), -1), axis=0))  # a, the lips' sets, i
+    assert sum(n.startswith("rest-") for n in kept) == 1 and sum(n.startswith("ep-") for n in kept) == distinct >= 3
+    damaged = next(cache.glob("ep-*.npz"))
+    damaged.write_bytes(b"not an npz file")
+    res = _run("speak", spoken / "lab.yaml", "--mesh", mesh_file, "--out", spoken / "again.wav",
+               "--solutions", spoken / "solutions")
+    assert res.exit_code == 0, res.output
+    again = speak.read(spoken / "again.h5")
+    assert sorted(p.name for p in cache.glob("*.npz")) == kept and damaged.read_bytes()[:2] == b"PK"
+    assert np.array_equal(again.eps_cm, first.eps_cm, equal_nan=True)
+    for name in first.control_points:
+        assert np.array_equal(again.control_points[name], first.control_points[name])
+
+
 def _praat_stop(wav, vowel: tuple[float, float], window: tuple[float, float]) -> tuple[float, float, float]:
     """A stop as Praat hears it: the one silence (30 dB or more below the vowel's intensity, measured over
     ``vowel``) inside ``window``, 40-120 ms long (a stop closure, the utterances' goal); returns its start and
