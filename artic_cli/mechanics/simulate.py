@@ -5,6 +5,7 @@ from __future__ import annotations
 import gc
 import time
 from contextlib import contextmanager
+from copy import deepcopy
 from dataclasses import dataclass, field
 from typing import Callable
 
@@ -38,6 +39,7 @@ class Trajectory:
     contact_nodes: list = field(default_factory=list)  # per frame: node ids
     contact_forces: list = field(default_factory=list)  # per frame: dyn
     projected: np.ndarray | None = None  # (T,) nodes projected back onto the wall
+    snapshots: dict = field(default_factory=dict)  # step number -> the state after it (``run``'s snapshots_every)
 
     @property
     def volume_change(self) -> np.ndarray:
@@ -97,10 +99,12 @@ single_threaded = threadpool_limits.wrap(limits=1, user_api="blas")
 def run(model: Model, state: State, control_at: Callable[[float], Control], duration: float,
         dt: float | None = None, record_every: int = 1,
         progress: Callable[[int, int], None] | None = None,
-        keep_partial: bool = False) -> tuple[Trajectory, State]:
+        keep_partial: bool = False, snapshots_every: int = 0) -> tuple[Trajectory, State]:
     """Integrate for ``duration`` seconds; record every ``record_every`` steps.  A step that fails
     (:class:`SimulationDiverged`) raises, or with ``keep_partial`` ends the run there: the trajectory up to the
-    last good step is returned with the failure in ``stats["failure"]``."""
+    last good step is returned with the failure in ``stats["failure"]``.  ``snapshots_every`` (a multiple of
+    ``record_every``): keep a copy of the whole state every so many steps, the start included, to resume from
+    (:mod:`.resume`)."""
     h = float(model.options.dt if dt is None else dt)
     n_steps = max(1, int(round(duration / h)))
     times, xs, vs, its = [state.t], [state.x.copy()], [state.v.copy()], [0]
@@ -119,6 +123,7 @@ def run(model: Model, state: State, control_at: Callable[[float], Control], dura
     gravity = model.node_mass[:, None] * model.gravity
     t0, c0 = time.perf_counter(), time.process_time()
     failure, done = None, 0
+    snapshots = {0: deepcopy(state)} if snapshots_every > 0 else {}
     with gc_paused():
         for k in range(1, n_steps + 1):
             ctl = control_at(state.t + 0.5 * h)  # inputs held over the step, sampled at its middle
@@ -130,6 +135,8 @@ def run(model: Model, state: State, control_at: Callable[[float], Control], dura
                 failure = str(err)
                 break
             done = k
+            if snapshots_every > 0 and k % snapshots_every == 0:
+                snapshots[k] = deepcopy(new)
             # work of the external forces (held over the step) and gravity
             w += float(np.einsum("ij,ij->", ctl.node_force + gravity, new.x - state.x))
             state = new
@@ -158,7 +165,7 @@ def run(model: Model, state: State, control_at: Callable[[float], Control], dura
                              "diagnostics_time_s": time.perf_counter() - t0 - wall, "failure": failure},
                       contact_count=np.array([len(c) for c in c_nodes]),
                       contact_total=np.array([float(np.sum(c)) for c in c_forces]),
-                      contact_nodes=c_nodes, contact_forces=c_forces, projected=np.array(proj))
+                      contact_nodes=c_nodes, contact_forces=c_forces, projected=np.array(proj), snapshots=snapshots)
     if ms is not None:
         traj.muscle_force = np.array(m_force)
         traj.muscle_length = np.array(m_len)

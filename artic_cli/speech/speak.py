@@ -26,6 +26,7 @@ from ..errors import ArticError, NotPhysical
 from ..geometry.anatomy import TONGUE_MUSCLES
 from ..mechanics.loads import muscle_force_vector, muscle_shares
 from ..mechanics.model import Control, Model
+from ..mechanics.resume import first_difference, resumed
 from ..mechanics.simulate import Trajectory, problems, run, settle
 from ..schedule import TractEntry, tract_controls
 from ..tract.areas import Tracts, port_positions, tracts_of
@@ -186,20 +187,37 @@ class Laps:
         self.clock = now
 
 
-def course_trajectory(model: Model, c: Course, cfg: Config, rest, progress=None, lap=None) -> Trajectory:
+SNAPSHOT_FRAMES = 4  # a trajectory kept to resume from (timing's rounds) holds its state every so many frames
+
+
+def course_trajectory(model: Model, c: Course, cfg: Config, rest, progress=None, lap=None, prior=None,
+                      resumable: bool = False) -> Trajectory:
     """The course simulated from ``rest``: the lead-in, then the sound's frames (its clock at the sound's
-    start)."""
+    start).  ``resumable``: the trajectory keeps snapshots to resume from; ``prior``: (an earlier course, its
+    resumable trajectory from the same ``rest``): the steps whose forces the two share are not simulated
+    again (:mod:`..mechanics.resume`; the frames are the same)."""
     zero = np.zeros((model.n_nodes, 3))
     dt = units.ms_to_s(cfg.simulation.dt_ms)
+    every = max(1, int(round(units.ms_to_s(cfg.speech.frame_ms) / dt)))
+    lead_in = lambda f: (lambda t: Control(node_force=zero, muscle_force=f(t)))  # noqa: E731
+    voiced = lambda f, prep: (lambda t: Control(node_force=zero, muscle_force=f(t + prep)))  # noqa: E731
+    n_prep, n_sound = int(round(c.prep_s / dt)), max(1, int(round(c.duration_s / dt)))
+    if prior is not None:
+        old, traj = prior
+        same_clock = (old.prep_s, old.duration_s) == (c.prep_s, c.duration_s) and 0 in traj.snapshots
+        if same_clock and first_difference(lead_in(old.force_at), lead_in(c.force_at), 0.0, dt, n_prep) > n_prep:
+            k = first_difference(voiced(old.force_at, old.prep_s), voiced(c.force_at, c.prep_s), 0.0, dt, n_sound)
+            return resumed(model, traj, voiced(c.force_at, c.prep_s), c.duration_s, dt, every, k,
+                           snapshots_every=every * SNAPSHOT_FRAMES, keep_partial=True)
     start = rest
     if c.prep_s > 0:  # the lead-in: the first segment's forces act before the sound starts
-        _, start = run(model, rest, lambda t: Control(node_force=zero, muscle_force=c.force_at(t)), c.prep_s, dt)
+        _, start = run(model, rest, lead_in(c.force_at), c.prep_s, dt)
         start = replace(start, t=0.0)
         if lap is not None:
             lap("lead-in")
-    every = max(1, int(round(units.ms_to_s(cfg.speech.frame_ms) / dt)))
-    traj, _ = run(model, start, lambda t: Control(node_force=zero, muscle_force=c.force_at(t + c.prep_s)),
-                  c.duration_s, dt, record_every=every, progress=progress, keep_partial=True)
+    traj, _ = run(model, start, voiced(c.force_at, c.prep_s), c.duration_s, dt, record_every=every,
+                  progress=progress, keep_partial=True,
+                  snapshots_every=every * SNAPSHOT_FRAMES if resumable or prior is not None else 0)
     return traj
 
 

@@ -84,13 +84,14 @@ def goals_of(targets: list[TargetSpec | None], cfg: Config) -> list[Goal]:
     return out
 
 
-def place_areas(u: Utterance, p: Plan, cfg: Config, model: Model, rest, goals: list[Goal]):
-    """(the utterance's movement, {segment: its place's area per frame, cm^2})."""
+def place_areas(u: Utterance, p: Plan, cfg: Config, model: Model, rest, goals: list[Goal], prior=None):
+    """(the utterance's movement, {segment: its place's area per frame, cm^2}, (its course, the movement): the
+    ``prior`` of the next round, which simulates only from where its forces differ)."""
     c = force_course(u, p, model, cfg)
-    traj = course_trajectory(model, c, cfg, rest)
+    traj = course_trajectory(model, c, cfg, rest, prior=prior, resumable=True)
     tracts = tracts_of_run(u, p, model, traj, cfg)
     region, _ = section_places(speaker_tract(cfg))
-    return traj, {g.segment: place_area(tracts.af.area_cm2, region, g.place) for g in goals}
+    return traj, {g.segment: place_area(tracts.af.area_cm2, region, g.place) for g in goals}, (c, traj)
 
 
 def made(area: np.ndarray, reach: float, floor: float = 0.0) -> np.ndarray:
@@ -149,11 +150,11 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
     segs = u.segments
     kn = leads_of(u, targets, default_leads_ms(u, cfg)[0])
     starts, ends = kn.starts, kn.starts + np.array([s.duration_ms for s in segs])
-    best = None
+    best = prior = None
     for r in range(rounds):
         trial = _with(u, kn.leads, kn.press)
         try:
-            traj, areas = place_areas(trial, p, cfg, model, rest, goals)
+            traj, areas, prior = place_areas(trial, p, cfg, model, rest, goals, prior)
             bad = bool(problems(traj, model.volume_constraint))
         except OffGrid:  # the tongue left the tract's grid
             bad = True

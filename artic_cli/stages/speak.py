@@ -19,11 +19,11 @@ import numpy as np
 from .. import units
 from ..config import DEFAULT_CONFIG, Config, load_config
 from ..errors import ArticError
-from ..io.array_cache import ArrayCache
+from ..io.result_cache import ResultCache
 from ..io.fingerprint import code_hash, digest
 from ..io.store import atomic_h5, open_artifact, stored_content_hash
 from ..io.wav import write_wav
-from ..mechanics.model import ARTICULATOR_SECTIONS, State
+from ..mechanics.model import ARTICULATOR_SECTIONS, Model, State
 from ..mechanics.simulate import settle
 from ..speech.plan import Plan, needs_dynamic, plan, segment_targets
 from ..speech.record import Record
@@ -42,7 +42,7 @@ from . import simulate as sim_stage
 from . import solve_runs
 from .base import Stage, up_to_date
 
-CACHE = "cache"  # beside the solutions: the rest posture and where each set of held forces leads
+CACHE = "cache"  # beside the solutions: the articulator, its rest posture and where each set of held forces leads
 STAGE = Stage(name="utterances", module=__name__,
               sections=(*ARTICULATOR_SECTIONS, "epmap", "solver", "vocal_tract", "acoustics", "speech"),
               reads=("mesh", "epmaps", "acousticmaps"), kind="utterance", hint="rerun 'artic speak UTTERANCE.yaml'")
@@ -240,24 +240,37 @@ def speak(utterance: Path | str | Utterance, out: Path | str | None = None, maps
     files = {"wav": out, "textgrid": textgrid_path(out), "h5": h5_path(out)}
     if up_to_date(files["h5"], prov) and files["wav"].is_file() and files["textgrid"].is_file():
         return SpeakResult(files, None, up_to_date=True)
-    model = loaded.once("articulator", lambda: sim_stage.build(cfg, m.mesh, m.wall), (mesh, config or DEFAULT_CONFIG))
+    scope = {"articulator": sim_stage.STAGE.provenance(cfg, inputs={"mesh": m.content_sha256}).recipe,
+             "code": code_hash("artic_cli.speech.speak")}  # what the model, its rest posture and the EPs hang on
+    caches = {kind: ResultCache(folder / CACHE, kind, scope) for kind in ("model", "rest", "ep")}
+    model = loaded.once("articulator", lambda: articulator(cfg, m, caches["model"]), (mesh, config or DEFAULT_CONFIG))
     check_forces(u, list(model.drivable()), str(source or u.name))
     solve = partial(solve_on, dynamic=dynamic if dynamic is not None and needs_dynamic(targets, cfg) else None)
     view = STAGE.view(cfg)
     p = plan(u, view, targets, solve, accept_nearest, say)
-    scope = {"articulator": sim_stage.STAGE.provenance(cfg, inputs={"mesh": m.content_sha256}).recipe,
-             "code": code_hash("artic_cli.speech.speak")}  # what the rest posture and the held forces' ends hang on
-    rest = rest_posture(model, ArrayCache(folder / CACHE, "rest", scope))
+    rest = rest_posture(model, caches["rest"])
     u, timing = timed(u, p, view, model, rest, targets)
     if timing is not None and say:
         say(f"timing: {timing.rounds} round(s); leads {', '.join(f'{v:.0f}' for v in timing.leads_ms)} ms; "
             f"presses {', '.join(f'{v:.2f}' for v in timing.press)}")
     s = speak_plan(u, p, view, model, progress, rest, timing.trajectory if timing is not None else None,
-                   ArrayCache(folder / CACHE, "ep", scope))
-    return SpeakResult(write(out, s, prov), s)
+                   caches["ep"])
+    written = write(out, s, prov)
+    for c in caches.values():  # kept only once the utterance is written
+        c.commit()
+    return SpeakResult(written, s)
 
 
-def rest_posture(model, cache: ArrayCache) -> State:
+def articulator(cfg: Config, m, cache: ResultCache):
+    """The articulator of mesh file ``m`` (:func:`sim_stage.build`), kept in ``cache`` (scope: its recipe)."""
+    model = cache.get_object("articulator")
+    if model is None or not isinstance(model, Model):
+        model = sim_stage.build(cfg, m.mesh, m.wall)
+        cache.put_object("articulator", model)
+    return model
+
+
+def rest_posture(model, cache: ResultCache) -> State:
     """The model's rest posture (:func:`settle`), kept in ``cache`` (its scope: the model's recipe)."""
     hit = cache.get("rest posture")
     if hit is not None and hit.get("x", np.zeros(0)).shape == (model.n_nodes, 3):

@@ -126,8 +126,8 @@ def test_a_spoken_sequence_writes_its_sound_textgrid_and_record(spoken, mesh_fil
 
 
 def test_the_rest_posture_and_held_forces_are_kept_and_give_the_same_record(spoken, mesh_file):
-    """A second speaking reads the rest posture and each set of held forces' end from the cache beside the
-    solutions, and writes the same record; a damaged entry is made again."""
+    """A second speaking reads the articulator, its rest posture and each set of held forces' end from the cache
+    beside the solutions, and writes the same record; a damaged entry is made again."""
     cache = spoken / "solutions" / speak.CACHE
     kept = sorted(p.name for p in cache.glob("*.npz"))
     first = speak.read(spoken / "lab.h5")
@@ -143,6 +143,23 @@ def test_the_rest_posture_and_held_forces_are_kept_and_give_the_same_record(spok
     assert np.array_equal(again.eps_cm, first.eps_cm, equal_nan=True)
     for name in first.control_points:
         assert np.array_equal(again.control_points[name], first.control_points[name])
+
+
+def test_the_articulator_is_kept_once_built_and_read_back_the_same(tmp_path, mesh_file, cfg):
+    from artic_cli.io.result_cache import ResultCache
+    from artic_cli.stages import mesh as mesh_stage
+
+    m = mesh_stage.read(mesh_file, cfg)
+    cache = ResultCache(tmp_path / "cache", "model", {"mesh": m.content_sha256})
+    built = speak.articulator(cfg, m, cache)
+    assert not (tmp_path / "cache").exists()  # nothing written before the run commits
+    cache.commit()
+    kept, = (tmp_path / "cache").glob("model-*.pickle")
+    back = speak.articulator(cfg, m, ResultCache(tmp_path / "cache", "model", {"mesh": m.content_sha256}))
+    assert back is not built and np.array_equal(back.rest, built.rest) and back.muscle_names == built.muscle_names
+    kept.write_bytes(b"damaged")  # a damaged entry is built again
+    assert np.array_equal(speak.articulator(cfg, m, ResultCache(tmp_path / "cache", "model",
+                                                                {"mesh": m.content_sha256})).rest, built.rest)
 
 
 def _praat_stop(wav, vowel: tuple[float, float], window: tuple[float, float]) -> tuple[float, float, float]:
