@@ -152,7 +152,7 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
     starts, ends = kn.starts, kn.starts + np.array([s.duration_ms for s in segs])
     best = prior = None
     for r in range(rounds):
-        trial = _with(u, kn.leads, kn.press)
+        trial = with_leads(u, kn.leads, kn.press)
         try:
             traj, areas, prior = place_areas(trial, p, cfg, model, rest, goals, prior)
             bad = bool(problems(traj, model.volume_constraint))
@@ -185,9 +185,9 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
         if not changed or score == 0.0:
             break
     if best is None:  # no round was physical: the last, for the caller to refuse
-        return _with(u, kn.leads, kn.press), None
+        return with_leads(u, kn.leads, kn.press), None
     _, _, (leads, press), late, early, held, traj = best
-    return _with(u, leads, press), Timing(leads_ms=leads.tolist(), press=press.tolist(), rounds=r + 1,
+    return with_leads(u, leads, press), Timing(leads_ms=leads.tolist(), press=press.tolist(), rounds=r + 1,
                                           onset_late_ms=late, released_early_ms=early, held_late_ms=held,
                                           trajectory=traj)
 
@@ -243,10 +243,11 @@ def missed_ms(goals: list[Goal], late: dict, early: dict, starts: np.ndarray, en
     return float(out)
 
 
-def _with(u: Utterance, leads, press) -> Utterance:
+def with_leads(u: Utterance, leads, press) -> Utterance:
+    """The utterance with each segment's lead (ms) and press."""
     segs = [s.model_copy(update={"lead_ms": round(float(a), 3), "press": round(float(b), 4)})
             for s, a, b in zip(u.segments, leads, press)]
     return u.model_copy(update={"segments": segs})
 
 
-__all__ = ["Goal", "Timing", "goals_of", "onset_and_release", "timed"]
+__all__ = ["Goal", "Timing", "goals_of", "onset_and_release", "timed", "with_leads"]

@@ -20,7 +20,7 @@ from .. import units
 from ..config import DEFAULT_CONFIG, Config, load_config
 from ..errors import ArticError
 from ..io.result_cache import ResultCache
-from ..io.fingerprint import code_hash, digest
+from ..io.fingerprint import code_hash, digest, sections_hash
 from ..io.store import atomic_h5, open_artifact, stored_content_hash
 from ..io.wav import write_wav
 from ..mechanics.model import ARTICULATOR_SECTIONS, Model, State
@@ -32,7 +32,7 @@ from ..speech.textgrid import write_textgrid
 from ..speech.inventory import DEFAULT as DEFAULT_INVENTORY
 from ..speech.inventory import load_inventory
 from ..speech.phones import realise, vowel_tongues
-from ..speech.timing import timed
+from ..speech.timing import Timing, timed, with_leads
 from ..speech.utterance import Utterance, check_forces, load_utterance
 from ..tract.places import section_places
 from ..tract.speaker import speaker_tract
@@ -242,16 +242,17 @@ def speak(utterance: Path | str | Utterance, out: Path | str | None = None, maps
         return SpeakResult(files, None, up_to_date=True)
     scope = {"articulator": sim_stage.STAGE.provenance(cfg, inputs={"mesh": m.content_sha256}).recipe,
              "code": code_hash("artic_cli.speech.speak")}  # what the model, its rest posture and the EPs hang on
-    caches = {kind: ResultCache(folder / CACHE, kind, scope) for kind in ("model", "rest", "ep")}
+    caches = {kind: ResultCache(folder / CACHE, kind, scope) for kind in ("model", "rest", "ep", "timing")}
     model = loaded.once("articulator", lambda: articulator(cfg, m, caches["model"]), (mesh, config or DEFAULT_CONFIG))
     check_forces(u, list(model.drivable()), str(source or u.name))
     solve = partial(solve_on, dynamic=dynamic if dynamic is not None and needs_dynamic(targets, cfg) else None)
     view = STAGE.view(cfg)
     p = plan(u, view, targets, solve, accept_nearest, say)
     rest = rest_posture(model, caches["rest"])
-    u, timing = timed(u, p, view, model, rest, targets)
+    u, timing = timed_once(u, p, view, model, rest, targets, caches["timing"])
     if timing is not None and say:
-        say(f"timing: {timing.rounds} round(s); leads {', '.join(f'{v:.0f}' for v in timing.leads_ms)} ms; "
+        how = f"{timing.rounds} round(s)" if timing.rounds else "as found before"
+        say(f"timing: {how}; leads {', '.join(f'{v:.0f}' for v in timing.leads_ms)} ms; "
             f"presses {', '.join(f'{v:.2f}' for v in timing.press)}")
     s = speak_plan(u, p, view, model, progress, rest, timing.trajectory if timing is not None else None,
                    caches["ep"])
@@ -268,6 +269,26 @@ def articulator(cfg: Config, m, cache: ResultCache):
         model = sim_stage.build(cfg, m.mesh, m.wall)
         cache.put_object("articulator", model)
     return model
+
+
+def timed_once(u: Utterance, p: Plan, cfg: Config, model, rest, targets, cache: ResultCache):
+    """:func:`timed`, its leads and presses kept in ``cache`` by what they hang on (the utterance but its name
+    and pitch, the plan, the config, the timing's code), so that the same utterance at another pitch or under
+    another name is not timed again: (the utterance with its leads and presses, its timing; rounds 0 when
+    found before)."""
+    key = {"utterance": u.model_dump(mode="json", exclude={"name", "f0_hz"}), "forces": p.forces_n,
+           "lips": p.lips, "ports": p.ports, "glottis": p.glottis_cm2, "voiced": p.voiced, "starts": p.starts_s,
+           "durations": p.durations_s, "config": sections_hash(cfg, STAGE.sections),
+           "code": code_hash("artic_cli.speech.timing")}
+    hit = cache.get(key)
+    if hit is not None and hit.get("leads_ms", np.zeros(0)).shape == (len(u.segments),) == hit["press"].shape:
+        return with_leads(u, hit["leads_ms"], hit["press"]), Timing(
+            leads_ms=hit["leads_ms"].tolist(), press=hit["press"].tolist(), rounds=0, onset_late_ms={},
+            released_early_ms={}, held_late_ms={})
+    out, timing = timed(u, p, cfg, model, rest, targets)
+    if timing is not None:
+        cache.put(key, {"leads_ms": np.asarray(timing.leads_ms, float), "press": np.asarray(timing.press, float)})
+    return out, timing
 
 
 def rest_posture(model, cache: ResultCache) -> State:

@@ -14,10 +14,11 @@ import time
 import numpy as np
 import pytest
 
-from conftest import ROOT, run_cli
+from conftest import ROOT, praat_f0, run_cli
 from artic_cli.corpus.index import finished, read_index
 from artic_cli.corpus.listing import read_listing
 from artic_cli.errors import ArticError
+from artic_cli.io.wav import read_wav
 from artic_cli.stages.corpus import Setup, run_corpus
 
 CONFIG = ROOT / "configs" / "ci_thin.yaml"  # thin maps: built in seconds
@@ -266,3 +267,33 @@ def test_a_worker_keeps_what_it_loaded_until_the_file_changes(tmp_path):
         loaded.once("test", make, (tmp_path / f"m{k}", None))
     assert len(loaded._kept["test"]) == loaded.KEEP  # the oldest dropped
     loaded.forget()
+
+
+def test_a_word_at_another_pitch_is_not_timed_again_and_moves_the_same(corpus_setup):
+    """The timing's leads and presses are kept beside the solutions (stages/speak.py, ``timed_once``): the same
+    word at another pitch range and under another name reuses them, moves exactly as before and sounds at its
+    own pitch."""
+    from artic_cli.speech.inventory import load_inventory
+    from artic_cli.speech.text import utterance_of_text
+    from artic_cli.stages import speak as speak_stage
+
+    tmp, setup = corpus_setup
+    inv = load_inventory(setup.inventory)
+    said = {}
+    for name, f0 in (("low", (90.0, 120.0)), ("high", (140.0, 190.0))):
+        said[name] = []
+        u = utterance_of_text("aka", inv, name=name, f0_range_hz=f0)
+        speak_stage.speak(u, tmp / "pitch" / f"{name}.wav", setup.maps, setup.mesh, setup.acoustic_maps,
+                          setup.config, tmp / "pitch" / "solutions", dynamic=setup.dynamic,
+                          inventory=setup.inventory, say=said[name].append)
+    timing = {k: [m for m in v if m.startswith("timing:")] for k, v in said.items()}
+    assert "round(s)" in timing["low"][0] and "as found before" in timing["high"][0], timing
+    assert timing["low"][0].split(";", 1)[1] == timing["high"][0].split(";", 1)[1]  # the same leads and presses
+    low, high = (speak_stage.read(tmp / "pitch" / f"{n}.h5") for n in ("low", "high"))
+    for name in low.control_points:
+        assert np.array_equal(low.control_points[name], high.control_points[name])
+    assert list(low.leads_ms) == list(high.leads_ms) and list(low.press) == list(high.press)
+    y, rate = read_wav(tmp / "pitch" / "low.wav")
+    times = np.linspace(0.03, len(y) / rate - 0.03, 25)
+    f0 = {n: float(np.nanmedian(praat_f0(tmp / "pitch" / f"{n}.wav", times))) for n in ("low", "high")}
+    assert 85 <= f0["low"] <= 125 and 135 <= f0["high"] <= 195, f0
