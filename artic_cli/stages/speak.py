@@ -48,11 +48,13 @@ STAGE = Stage(name="utterances", module=__name__,
               reads=("mesh", "epmaps", "acousticmaps"), kind="utterance", hint="rerun 'artic speak UTTERANCE.yaml'")
 
 
-def compute(u: Utterance, p: Plan, cfg: Config, mesh, wall, progress=None, model=None) -> Spoken:
+def compute(u: Utterance, p: Plan, cfg: Config, mesh, wall, progress=None, model=None, rest=None, known=None
+            ) -> Spoken:
     """Simulate the plan's force course from the rest posture and voice it (``model``: the articulator of
-    ``mesh``, ``wall`` and ``cfg``, if already built)."""
+    ``mesh``, ``wall`` and ``cfg``, if already built; ``rest``: its rest posture, if settled; ``known``: a cache
+    of where force sets lead, :class:`ResultCache`)."""
     model = sim_stage.build(cfg, mesh, wall) if model is None else model
-    return speak_plan(u, p, STAGE.view(cfg), model, progress)
+    return speak_plan(u, p, STAGE.view(cfg), model, progress, rest, known=known)
 
 
 # --- files ---------------------------------------------------------------------------------------------
