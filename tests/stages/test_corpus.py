@@ -297,3 +297,73 @@ def test_a_word_at_another_pitch_is_not_timed_again_and_moves_the_same(corpus_se
     times = np.linspace(0.03, len(y) / rate - 0.03, 25)
     f0 = {n: float(np.nanmedian(praat_f0(tmp / "pitch" / f"{n}.wav", times))) for n in ("low", "high")}
     assert 85 <= f0["low"] <= 125 and 135 <= f0["high"] <= 195, f0
+
+
+def _word_phones(spoken, item):
+    from artic_cli.speech.inventory import load_inventory
+    from artic_cli.speech.textgrid import read_phones
+    from artic_cli.stages import speak as speak_stage
+
+    out, _, _ = spoken
+    wav = out / "items" / f"{item}.wav"
+    inv = load_inventory()
+    y, rate = read_wav(wav)
+    return wav, speak_stage.read(wav.with_suffix(".h5")), y, rate, read_phones(wav.with_suffix(".TextGrid")), inv
+
+
+def _middle(a, b):
+    return a + 0.25 * (b - a), b - 0.25 * (b - a)
+
+
+def _praat_voiced(wav, a, b) -> float:
+    return float(np.mean(np.isfinite(praat_f0(wav, np.arange(a + 0.0025, b, 0.005)))))
+
+
+def test_praat_hears_the_spoken_words_phones_as_the_judge_measures_them(spoken):
+    """Issue 46's judge (speech/judge.py, speech/landmarks.py) on words spoken from text (aka, papa, gaga, ama
+    on the CI speaker), against Praat on the same WAVs over the TextGrid's intervals: a consonant between vowels
+    has its level against their middle halves within 2 dB of Praat's (where Praat hears more than 50 dB below
+    the vowels: a closure with no voice is digital silence, where Praat's floor decides), and a vowel Praat
+    hears voiced through its middle half is heard as the same vowel (Praat's Burg formants), F1 and F2 within
+    10 %."""
+    from artic_cli.speech.judge import phone_results
+    from artic_cli.speech.landmarks import consonants
+    from artic_cli.speech.vowel_class import nearest_vowel
+
+    from conftest import praat_formants_near, praat_level_db
+
+    checked = {"consonant": 0, "vowel": 0}
+    for item in ("w05", "w06", "w07", "w08"):
+        wav, rec, y, rate, iv, inv = _word_phones(spoken, item)
+        manners = {k: p.manner for k, p in inv.phonemes.items()}
+        means = {v: tuple(p.formants_hz[:2]) for v, p in inv.phonemes.items() if p.manner == "vowel"}
+        vowels = [(a, b) for a, b, s in iv if manners.get(s) == "vowel"]
+        ref = float(np.mean([praat_level_db(wav, *_middle(a, b)) for a, b in vowels]))
+        for m in consonants(y, rate, iv, manners):
+            t0, t1 = m["start_s"], m["start_s"] + m["duration_ms"] / 1e3
+            praat = praat_level_db(wav, t0, t1) - ref
+            if t0 > 0 and praat > -50:
+                assert abs(m["level_db"] - praat) <= 2.0, (item, m["symbol"], m["level_db"], praat)
+                checked["consonant"] += 1
+        for r in phone_results(y, rate, iv, rec.time_s, rec.formants_hz, inv):
+            a, b = _middle(r["start_s"], r["end_s"])
+            if r["kind"] != "vowel" or _praat_voiced(wav, a, b) < 0.9:
+                continue
+            inside = (rec.time_s >= a) & (rec.time_s <= b)
+            f = [float(np.nanmedian(rec.formants_hz[inside, k])) for k in (0, 1)]
+            heard, _ = praat_formants_near(wav, np.linspace(a, b, 7), f)
+            assert nearest_vowel(*f, means) == nearest_vowel(heard[0], heard[1], means), (item, r, heard, f)
+            assert abs(heard[0] / f[0] - 1) <= 0.10 and abs(heard[1] / f[1] - 1) <= 0.10, (item, r, heard, f)
+            checked["vowel"] += 1
+    assert checked["consonant"] >= 2 and checked["vowel"] >= 3, checked
+
+
+@pytest.mark.xfail(strict=True, reason="ours calls /ama/'s /m/ from text voiced in 100 % of it, Praat in 78 % "
+                                       "(the lab's /ama/ agrees within 0.15: tests/acoustics/test_sources.py)")
+def test_praat_hears_a_word_s_nasal_voiced_as_the_judge_does(spoken):
+    from artic_cli.speech.landmarks import consonants
+
+    wav, rec, y, rate, iv, inv = _word_phones(spoken, "w08")
+    m, = [m for m in consonants(y, rate, iv, {k: p.manner for k, p in inv.phonemes.items()}) if m["symbol"] == "m"]
+    t0, t1 = m["start_s"], m["start_s"] + m["duration_ms"] / 1e3
+    assert abs(m["voiced_share"] - _praat_voiced(wav, t0, t1)) <= 0.15
