@@ -42,7 +42,7 @@ from . import simulate as sim_stage
 from . import solve_runs
 from .base import Stage, up_to_date
 
-CACHE = "cache"  # beside the solutions: the articulator, its rest posture and where each set of held forces leads
+CACHE = "cache"  # beside the solutions: the articulator, its rest posture, where held force sets lead, timings
 STAGE = Stage(name="utterances", module=__name__,
               sections=(*ARTICULATOR_SECTIONS, "epmap", "solver", "vocal_tract", "acoustics", "speech"),
               reads=("mesh", "epmaps", "acousticmaps"), kind="utterance", hint="rerun 'artic speak UTTERANCE.yaml'")
