@@ -32,30 +32,27 @@ class ResultCache:
         return self.folder / f"{self.kind}-{digest([self.scope, key])[:32]}{suffix}"
 
     def get(self, key) -> dict[str, np.ndarray] | None:
-        path = self.path(key)
-        if path in self.pending:
-            return self.pending[path][1]
-        if not path.is_file():
-            return None
-        with contextlib.suppress(Exception), np.load(path, allow_pickle=False) as f:
-            return {name: f[name] for name in f.files}
-        return None
+        return self._read(self.path(key), lambda fh: dict(np.load(fh, allow_pickle=False)))
 
     def put(self, key, arrays: dict[str, np.ndarray]) -> None:
         self.pending[self.path(key)] = ("npz", {k: np.asarray(v) for k, v in arrays.items()})
 
     def get_object(self, key):
-        path = self.path(key, ".pickle")
+        return self._read(self.path(key, ".pickle"), pickle.load)
+
+    def put_object(self, key, obj) -> None:
+        self.pending[self.path(key, ".pickle")] = ("pickle", obj)
+
+    def _read(self, path: Path, load):
+        """What was put at ``path`` and not yet written, else the file read by ``load`` (None: missing or
+        damaged)."""
         if path in self.pending:
             return self.pending[path][1]
         if not path.is_file():
             return None
         with contextlib.suppress(Exception), open(path, "rb") as fh:
-            return pickle.load(fh)
+            return load(fh)
         return None
-
-    def put_object(self, key, obj) -> None:
-        self.pending[self.path(key, ".pickle")] = ("pickle", obj)
 
     def commit(self) -> None:
         """Write what was put (a run that failed commits nothing, and leaves no folder behind)."""

@@ -60,7 +60,8 @@ def spliced(head: Trajectory, at_step: int, tail: Trajectory, record_every: int)
     stats["resumed_at_step"] = at_step
     return Trajectory(time=join(head.time, tail.time), x=join(head.x, tail.x), v=join(head.v, tail.v),
                       volume=join(head.volume, tail.volume), iterations=join(head.iterations, tail.iterations),
-                      energy=join(head.energy, tail.energy + head.energy[i]), work=join(head.work, tail.work + head.work[i]),
+                      energy=join(head.energy, tail.energy + head.energy[i]),
+                      work=join(head.work, tail.work + head.work[i]),
                       inverted=join(head.inverted, tail.inverted), stats=stats,
                       muscle_force=join(head.muscle_force, tail.muscle_force),
                       muscle_length=join(head.muscle_length, tail.muscle_length),

@@ -217,7 +217,7 @@ def course_trajectory(model: Model, c: Course, cfg: Config, rest, progress=None,
             lap("lead-in")
     traj, _ = run(model, start, voiced(c.force_at, c.prep_s), c.duration_s, dt, record_every=every,
                   progress=progress, keep_partial=True,
-                  snapshots_every=every * SNAPSHOT_FRAMES if resumable or prior is not None else 0)
+                  snapshots_every=every * SNAPSHOT_FRAMES if resumable else 0)
     return traj
 
 

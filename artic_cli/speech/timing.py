@@ -188,8 +188,8 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
         return with_leads(u, kn.leads, kn.press), None
     _, _, (leads, press), late, early, held, traj = best
     return with_leads(u, leads, press), Timing(leads_ms=leads.tolist(), press=press.tolist(), rounds=r + 1,
-                                          onset_late_ms=late, released_early_ms=early, held_late_ms=held,
-                                          trajectory=traj)
+                                               onset_late_ms=late, released_early_ms=early, held_late_ms=held,
+                                               trajectory=traj)
 
 
 def correct(kn: Leads, g: Goal, segs, t: np.ndarray, area: np.ndarray, measured: tuple, end_ms: float) -> bool:
