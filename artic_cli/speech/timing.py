@@ -14,7 +14,9 @@ place read frame by frame, and the leads and presses moved by what was measured:
 * one released before its end (or, never made, narrowest before its end) delays the next segment's switch by
   as much;
 * one made more than ``EARLY_MS`` before its start leads less by as much, less ``WINDOW_MS`` (a tap between
-  high vowels, whose tongue is near the ridge already);
+  high vowels, whose tongue is near the ridge already); what is made before the utterance's sound begins
+  counts as made at its start (a word-initial /g/ shut during the preparation is not early), and a constriction
+  the next segment continues (a geminate Q and its consonant) is held into it and made before it by design;
 * one still held more than ``HELD_MS`` after its end brings the next segment's switch forward by as long
   (a release on time: a stop's burst inside its interval, a voiced closure no longer than its voicing lasts).
 
@@ -23,8 +25,11 @@ presses become their ceilings less a step, and every press above 1 softens a ste
 faster than a speaker moves (peak speeds beyond the EMA range + 50 %), which counts as missing the share it is
 too fast of every constriction's interval.  Leads keep their bounds (:mod:`.leads`: a segment after a vowel
 switches on no earlier than the vowel's middle until it may press no harder).  The rounds stop when nothing
-moves or every constriction is on time; the round that missed the fewest ms of its constrictions' intervals is
-the one kept (the corrections of a closure and of the channel after it can swing), with what it measured.
+moves or every constriction is on time; the round that missed the fewest ms of its constrictions' intervals and
+of its vowels is the one kept (the corrections of a closure and of the channel after it can swing), with what it
+measured.  A vowel counts as missed by as much of its duration as its dorsum and jaw stay, over its middle half,
+beyond ``VOWEL_FREE_CM`` from where its forces lead them (its EP), a share growing to all of it ``VOWEL_CM``
+further: a consonant that leads so far into a vowel that the vowel is not heard costs that vowel.
 """
 
 from __future__ import annotations
@@ -33,6 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import units
 from ..config import Config
 from ..control.solver import TargetSpec
 from ..errors import OffGrid
@@ -43,7 +49,7 @@ from ..tract.speaker import speaker_tract
 from .leads import LEAD_STEP_MS, Leads, leads_of
 from .measures import peak_speeds, too_fast
 from .plan import Plan
-from .speak import course_trajectory, default_leads_ms, force_course, tracts_of_run
+from .speak import course_trajectory, default_leads_ms, equilibria, force_course, tracts_of_run
 from .utterance import Utterance
 
 ROUNDS = 9
@@ -51,6 +57,9 @@ SLACK_MS = 3.0  # reached within this of the start, held to within this of the e
 WINDOW_MS = 20.0  # a constriction made this long before its interval counts as reached at its start
 HELD_MS = 15.0  # a constriction held longer than this past its interval's end: the next segment leads more
 EARLY_MS = 40.0  # ... made longer than this before its start: its own segment leads less
+# a vowel whose dorsum and jaw stay (mean) within VOWEL_FREE_CM of its EP over its middle half is made, one more
+# than VOWEL_CM further off missed whole
+VOWEL_FREE_CM, VOWEL_CM = 0.4, 0.6
 
 
 @dataclass
@@ -82,6 +91,14 @@ def goals_of(targets: list[TargetSpec | None], cfg: Config) -> list[Goal]:
             floor = c.area_cm2 - c.tolerance_cm2 if c.area_cm2 > c.tolerance_cm2 else 0.0
             out.append(Goal(k, place_index(names, c.place), float(c.area_cm2 + c.tolerance_cm2), float(floor)))
     return out
+
+
+def joined_goals(goals: list[Goal]) -> set[int]:
+    """The segments whose constriction the next segment continues: the same place and range (a geminate Q and its
+    consonant, a moraic nasal before /n/), one closure or channel held over both."""
+    by = {g.segment: g for g in goals}
+    return {k for k, g in by.items() if k + 1 in by and (by[k + 1].place, by[k + 1].reach_cm2, by[k + 1].floor_cm2)
+            == (g.place, g.reach_cm2, g.floor_cm2)}
 
 
 def place_areas(u: Utterance, p: Plan, cfg: Config, model: Model, rest, goals: list[Goal], prior=None):
@@ -140,14 +157,47 @@ def made_before(t: np.ndarray, area: np.ndarray, reach: float, start: float, flo
     return 1e3 * max(start - first, 0.0)
 
 
+def vowel_eps(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[TargetSpec | None],
+              known=None) -> list[tuple[int, np.ndarray]]:
+    """(segment, its EP: tip, dorsum, jaw (3, 3) cm) of each vowel (a segment with an acoustic target): where its
+    forces lead (:func:`..speak.equilibria`; ``known``: their cache)."""
+    ks = [k for k, t in enumerate(targets) if t is not None and t.acoustic is not None]
+    if not ks:
+        return []
+    vectors = force_course(u, p, model, cfg).vectors
+    eps = equilibria(model, rest, vectors[ks], units.ms_to_s(cfg.speech.reach_hold_ms),
+                     units.ms_to_s(cfg.simulation.dt_ms), known)
+    return list(zip(ks, eps))
+
+
+def vowels_missed_ms(marks: list[tuple[int, np.ndarray]], starts: np.ndarray, ends: np.ndarray, traj, model: Model
+                     ) -> float:
+    """How much of the vowels a round missed (ms): each vowel's duration times how far (mean of the dorsum's and
+    the jaw's distance, over its middle half, beyond ``VOWEL_FREE_CM``, in ``VOWEL_CM``, at most 1) they stayed
+    from its EP."""
+    pts = model.control_points()
+    out = 0.0
+    for k, ep in marks:
+        a, b = starts[k] + 0.25 * (ends[k] - starts[k]), starts[k] + 0.75 * (ends[k] - starts[k])
+        sel = (traj.time >= a / 1e3) & (traj.time <= b / 1e3)
+        if not sel.any() or not np.all(np.isfinite(ep)):
+            continue
+        d = [np.linalg.norm(traj.x[sel, pts[n], :2] - ep[j, :2], axis=1) for j, n in ((1, "dorsum"), (2, "jaw"))]
+        off = float(np.mean(0.5 * (d[0] + d[1]))) - VOWEL_FREE_CM
+        out += (ends[k] - starts[k]) * float(np.clip(off / VOWEL_CM, 0.0, 1.0))
+    return out
+
+
 def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[TargetSpec | None],
-          rounds: int = ROUNDS) -> tuple[Utterance, Timing | None]:
+          rounds: int = ROUNDS, known=None) -> tuple[Utterance, Timing | None]:
     """The utterance with the leads and presses its constrictions need (see the module's text); unchanged, with
     no timing, when it asks for no constriction."""
     goals = goals_of(targets, cfg)
     if not goals:
         return u, None
     segs = u.segments
+    joined = joined_goals(goals)
+    marks = vowel_eps(u, p, cfg, model, rest, targets, known)
     kn = leads_of(u, targets, default_leads_ms(u, cfg)[0])
     starts, ends = kn.starts, kn.starts + np.array([s.duration_ms for s in segs])
     best = prior = None
@@ -170,11 +220,17 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
             k = g.segment
             area = areas[k]
             late[k], early[k] = onset_and_release(t, area, g.reach_cm2, starts[k] / 1e3, ends[k] / 1e3, g.floor_cm2)
-            soon[k] = made_before(t, area, g.reach_cm2, starts[k] / 1e3, g.floor_cm2)
+            # made early only while there is sound: an utterance-initial closure may shut before it starts
+            soon[k] = min(made_before(t, area, g.reach_cm2, starts[k] / 1e3, g.floor_cm2), float(starts[k]))
             held[k] = held_after(t, area, g.reach_cm2, ends[k] / 1e3, g.floor_cm2) if np.isfinite(late[k]) else 0.0
+            if k in joined:  # one constriction over two segments (Q and its consonant): held into the next by design
+                held[k] = 0.0
+            if k - 1 in joined:  # ... and made before the second starts
+                soon[k] = 0.0
             changed |= correct(kn, g, segs, t, area, (late[k], early[k], soon[k], held[k]), ends[k])
         kn.in_order()
         score = missed_ms(goals, late, early, starts, ends, areas, t)
+        score += vowels_missed_ms(marks, starts, ends, traj, model)
         score += sum(max(h - HELD_MS, 0.0) for h in held.values()) + sum(max(a - EARLY_MS, 0.0) for a in soon.values())
         fast = too_fast(peak_speeds(t, {n: traj.x[:, i] for n, i in model.control_points().items()}))
         if fast:  # too fast: as bad as missing that share more of every constriction's interval; presses softer

@@ -71,3 +71,40 @@ def test_an_unphysical_round_softens_every_free_press_above_one_a_step():
     assert soften(press, [True, True, True, True, False])
     assert press.tolist() == pytest.approx([1.0, 1.75 / PRESS_STEP, 0.8, 1.0, 2.0])  # given presses kept
     assert not soften(np.array([1.0, 0.9]), [True, True])  # nothing left to soften
+
+
+def test_a_geminate_and_its_consonant_are_one_constriction():
+    from artic_cli.speech.timing import Goal, joined_goals
+    q, k, next_vowel_k = Goal(2, 4, 0.01), Goal(3, 4, 0.01), Goal(5, 4, 0.01)
+    assert joined_goals([q, k, next_vowel_k]) == {2}  # Q then its /k/; the /k/ two segments on is its own
+    assert joined_goals([Goal(2, 4, 0.01), Goal(3, 5, 0.01)]) == set()  # another place
+    assert joined_goals([Goal(2, 4, 0.01), Goal(3, 4, 0.13, 0.07)]) == set()  # a closure, then a channel
+
+
+class _Points:
+    """The one thing the vowel measure asks of a model: which nodes are the control points."""
+
+    def control_points(self):
+        return {"tip": 0, "dorsum": 1, "jaw": 2}
+
+
+def test_a_vowel_is_missed_by_how_far_its_dorsum_and_jaw_stay_from_its_ep():
+    from types import SimpleNamespace
+
+    from artic_cli.speech.timing import VOWEL_CM, VOWEL_FREE_CM, vowels_missed_ms
+    time = np.arange(0.0, 0.2, 0.005)
+    ep = np.zeros((3, 3))
+    x = np.zeros((len(time), 3, 3))
+    starts, ends = np.array([0.0, 100.0]), np.array([100.0, 200.0])
+    at_ep = SimpleNamespace(time=time, x=x)
+    assert vowels_missed_ms([(0, ep)], starts, ends, at_ep, _Points()) == 0.0
+    off = x.copy()
+    off[:, 1, 1] = off[:, 2, 1] = VOWEL_FREE_CM + 0.5 * VOWEL_CM  # dorsum and jaw half way past the free band
+    assert vowels_missed_ms([(0, ep)], starts, ends, SimpleNamespace(time=time, x=off), _Points()) == \
+        pytest.approx(50.0)
+    off[:, 1, 1] = off[:, 2, 1] = 5.0  # far off: the whole vowel
+    assert vowels_missed_ms([(0, ep)], starts, ends, SimpleNamespace(time=time, x=off), _Points()) == \
+        pytest.approx(100.0)
+    late = x.copy()
+    late[time >= 0.080, 1, 1] = 5.0  # off only after its middle half (25-75 ms): not missed
+    assert vowels_missed_ms([(0, ep)], starts, ends, SimpleNamespace(time=time, x=late), _Points()) == 0.0
