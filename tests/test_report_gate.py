@@ -10,8 +10,8 @@ from conftest import ROOT, newly_differing, report_rows
 ACCEPTED = ("Cuboid: apparent Poisson ratio, Eq. (4)", "Figs. 5/6: GGp from", "Table III contribution factor of GGm ",
             "Table III contribution factor of GGp ", "Table III contribution factor of SG ",
             "Table IV: derived vs simulated map, jaw JO_6 ", "Consonant landmarks",
-            "Articulators (issue 45", "/acha/: peak speeds", "/aka/: closure",
-            "Vowels beside the consonants (issue 45",
+            "Articulators (issue 45", "/aka/: closure",
+            "/ata/: closure",  # the timing counts the vowels: docs/inventory.md, "Timing"
             "Centroids of /sh/ below /s/",
             "Words from text:")  # issue 46's goals, open: docs/inventory.md, "What is measured on words"
 
