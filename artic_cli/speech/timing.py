@@ -25,8 +25,8 @@ presses become their ceilings less a step, and every press above 1 softens a ste
 faster than a speaker moves (peak speeds beyond the EMA range + 50 %), which counts as missing the share it is
 too fast of every constriction's interval.  Leads keep their bounds (:mod:`.leads`: a segment after a vowel
 switches on no earlier than the vowel's middle until it may press no harder).  The rounds stop when nothing
-moves or every constriction is on time; the round that missed the fewest ms of its constrictions' intervals and
-of its vowels is the one kept (the corrections of a closure and of the channel after it can swing), with what it
+moves or every constriction is on time; of the rounds within the speed limits (any, when none is) the one that
+missed the fewest ms of its constrictions' intervals and of its vowels is the one kept (the corrections of a closure and of the channel after it can swing), with what it
 measured.  A vowel counts as missed by as much of its duration as its dorsum and jaw stay, over its middle half,
 beyond ``VOWEL_FREE_CM`` from where its forces lead them (its EP), a share growing to all of it ``VOWEL_CM``
 further: a consonant that leads so far into a vowel that the vowel is not heard costs that vowel.
@@ -236,8 +236,9 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
         if fast:  # too fast: as bad as missing that share more of every constriction's interval; presses softer
             score += (max(fast.values()) - 1.0) * sum(ends[g.segment] - starts[g.segment] for g in goals)
             changed |= kn.too_hard()
-        if best is None or score < best[0]:
-            best = (score, r, tried, late, early, held, traj)
+        key = (bool(fast), score)  # a round within the speed limits before any beyond them
+        if best is None or key < best[0]:
+            best = (key, r, tried, late, early, held, traj)
         if not changed or score == 0.0:
             break
     if best is None:  # no round was physical: the last, for the caller to refuse
