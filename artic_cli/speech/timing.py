@@ -239,6 +239,7 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
         key = (bool(fast), score)  # a round within the speed limits before any beyond them
         if best is None or key < best[0]:
             best = (key, r, tried, late, early, held, traj)
+        changed &= not (np.array_equal(kn.leads, tried[0]) and np.array_equal(kn.press, tried[1]))  # all at a bound
         if not changed or score == 0.0:
             break
     if best is None:  # no round was physical: the last, for the caller to refuse
