@@ -26,10 +26,11 @@ faster than a speaker moves (peak speeds beyond the EMA range + 50 %), which cou
 too fast of every constriction's interval.  Leads keep their bounds (:mod:`.leads`: a segment after a vowel
 switches on no earlier than the vowel's middle until it may press no harder).  The rounds stop when nothing
 moves or every constriction is on time; of the rounds within the speed limits (any, when none is) the one that
-missed the fewest ms of its constrictions' intervals and of its vowels is the one kept (the corrections of a closure and of the channel after it can swing), with what it
-measured.  A vowel counts as missed by as much of its duration as its dorsum and jaw stay, over its middle half,
-beyond ``VOWEL_FREE_CM`` from where its forces lead them (its EP), a share growing to all of it ``VOWEL_CM``
-further: a consonant that leads so far into a vowel that the vowel is not heard costs that vowel.
+missed the fewest ms of its constrictions' intervals and of its vowels is the one kept (the corrections of a
+closure and of the channel after it can swing), with what it measured.  A vowel counts as missed by as much
+of its duration as its dorsum and jaw stay, over its middle half, beyond ``VOWEL_FREE_CM`` from where its
+forces lead them (its EP), a share growing to all of it ``VOWEL_CM`` further: a consonant that leads so far
+into a vowel that the vowel is not heard costs that vowel.
 """
 
 from __future__ import annotations
