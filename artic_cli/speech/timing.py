@@ -50,7 +50,8 @@ from ..tract.speaker import speaker_tract
 from .leads import LEAD_STEP_MS, Leads, leads_of
 from .measures import peak_speeds, too_fast
 from .plan import Plan
-from .speak import course_trajectory, default_leads_ms, equilibria, force_course, tracts_of_run
+from .speak import (course_trajectory, default_leads_ms, equilibria, force_course, segment_vectors,
+                    tracts_of_run)
 from .utterance import Utterance
 
 ROUNDS = 9
@@ -165,8 +166,8 @@ def vowel_eps(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: l
     ks = [k for k, t in enumerate(targets) if t is not None and t.acoustic is not None]
     if not ks:
         return []
-    vectors = force_course(u, p, model, cfg).vectors
-    eps = equilibria(model, rest, vectors[ks], units.ms_to_s(cfg.speech.reach_hold_ms),
+    vectors = segment_vectors(u, p, model, cfg.muscles.max_force_n)[ks]
+    eps = equilibria(model, rest, vectors, units.ms_to_s(cfg.speech.reach_hold_ms),
                      units.ms_to_s(cfg.simulation.dt_ms), known)
     return list(zip(ks, eps))
 
@@ -221,13 +222,13 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
             k = g.segment
             area = areas[k]
             late[k], early[k] = onset_and_release(t, area, g.reach_cm2, starts[k] / 1e3, ends[k] / 1e3, g.floor_cm2)
-            # made early only while there is sound: an utterance-initial closure may shut before it starts
-            soon[k] = min(made_before(t, area, g.reach_cm2, starts[k] / 1e3, g.floor_cm2), float(starts[k]))
-            held[k] = held_after(t, area, g.reach_cm2, ends[k] / 1e3, g.floor_cm2) if np.isfinite(late[k]) else 0.0
-            if k in joined:  # one constriction over two segments (Q and its consonant): held into the next by design
-                held[k] = 0.0
-            if k - 1 in joined:  # ... and made before the second starts
-                soon[k] = 0.0
+            # made early only while there is sound (an utterance-initial closure may shut before it starts), and
+            # not at all the second of one constriction over two segments (Q and its consonant) ...
+            soon[k] = 0.0 if k - 1 in joined else min(
+                made_before(t, area, g.reach_cm2, starts[k] / 1e3, g.floor_cm2), float(starts[k]))
+            # ... whose first is held into it by design
+            held[k] = held_after(t, area, g.reach_cm2, ends[k] / 1e3, g.floor_cm2) if (
+                np.isfinite(late[k]) and k not in joined) else 0.0
             changed |= correct(kn, g, segs, t, area, (late[k], early[k], soon[k], held[k]), ends[k])
         kn.in_order()
         score = missed_ms(goals, late, early, starts, ends, areas, t)
