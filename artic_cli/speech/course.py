@@ -54,19 +54,21 @@ def to_antagonists(pulse: np.ndarray, antagonists) -> np.ndarray:
     return out
 
 
-def pulse_step(starts_s, durations_s, vectors, pulse_s: float, gain: float, upper: float, antagonists=()):
+def pulse_step(starts_s, durations_s, vectors, pulse_s: float, gain, upper: float, antagonists=()):
     """The sets of a pulse-step course (beyond the paper): each segment opens with a pulse of
-    ``F_k + gain (F_k - F_k-1)`` for ``pulse_s`` (at most half the segment), then holds F_k; a pulse below zero
+    ``F_k + gain_k (F_k - F_k-1)`` for ``pulse_s`` (at most half the segment), then holds F_k (``gain``: one for
+    all, or one per segment); a pulse below zero
     in one of the ``antagonists`` pairs (shares_a, shares_b) drives the other side instead (a jaw that has to
     close closes with its closers, as it opened with its openers); clipped to 0..``upper``.  Returns the
     starts and vectors to give :func:`course`."""
     v = np.asarray(vectors, float)
+    gains = np.broadcast_to(np.asarray(gain, float), (len(v),))
     starts, sets = [], []
     before = np.zeros(v.shape[1])
-    for t0, d, f in zip(np.asarray(starts_s, float), np.asarray(durations_s, float), v):
+    for t0, d, f, g in zip(np.asarray(starts_s, float), np.asarray(durations_s, float), v, gains):
         width = min(pulse_s, 0.5 * d)
         starts += [t0, t0 + width]
-        sets += [np.clip(to_antagonists(f + gain * (f - before), antagonists), 0.0, upper), f]
+        sets += [np.clip(to_antagonists(f + g * (f - before), antagonists), 0.0, upper), f]
         before = f
     return np.array(starts), np.array(sets)
 

@@ -5,7 +5,10 @@ heard; a closure that cannot be made in the time left presses harder instead, an
 harder (at ``PRESS_MAX``, or a press found too hard: not physical, or faster than a speaker moves) does its lead
 reach further into the vowel (by as much as it was late, or ``LEAD_STEP_MS`` when never made).  A segment after
 a consonant switches on no sooner after that consonant's switch than its sound lasts (a tap's forces not cut
-short by the vowel after it).  A lead or press the utterance gives is left as given.
+short by the vowel after it).  Each segment's ``drive`` scales the pulse that opens its forces: a vowel not
+reached drives harder (x ``DRIVE_STEP`` up to ``DRIVE_MAX``), a drive found too hard is never reached again, and
+a movement faster than a speaker's with nothing pressed or driven above 1 drives softer (down to
+``DRIVE_MIN``).  A lead, press or drive the utterance gives is left as given.
 """
 
 from __future__ import annotations
@@ -18,6 +21,7 @@ from ..control.solver import TargetSpec
 
 PRESS_STEP, PRESS_MAX = 1.15, 2.0
 LEAD_STEP_MS, LEAD_MAX_MS, MIN_GAP_MS = 20.0, 250.0, 10.0
+DRIVE_STEP, DRIVE_MAX, DRIVE_MIN = 1.5, 3.0, 0.25
 VOWEL_KEPT = 0.5  # a segment after a voiced vowel switches on no earlier than this share into the vowel
 
 
@@ -33,6 +37,15 @@ class Leads:
     ceiling: np.ndarray  # the hardest press
     free_lead: list[bool]
     free_press: list[bool]
+    drive: np.ndarray | None = None  # each segment's opening pulse's factor (None: 1 each)
+    drive_ceiling: np.ndarray | None = None  # ... the hardest
+    free_drive: list[bool] | None = None
+
+    def __post_init__(self):
+        n = len(self.leads)
+        self.drive = np.ones(n) if self.drive is None else np.asarray(self.drive, float)
+        self.drive_ceiling = np.full(n, DRIVE_MAX) if self.drive_ceiling is None else self.drive_ceiling
+        self.free_drive = [True] * n if self.free_drive is None else self.free_drive
 
     def longest(self, k: int) -> float:
         """The longest lead segment ``k`` may have: its cap, and its gap after segment ``k - 1``'s switch."""
@@ -83,18 +96,37 @@ class Leads:
         self.cap[k] = min(self.cap[k] + by_ms, LEAD_MAX_MS)
         return self.lead_more(k, by_ms)
 
+    def drive_more(self, k: int) -> bool:
+        """Segment ``k``'s pulse a step harder, up to its ceiling; whether it moved."""
+        if not self.free_drive[k] or self.drive[k] >= self.drive_ceiling[k] - 1e-9:
+            return False
+        self.drive[k] = min(self.drive[k] * DRIVE_STEP, self.drive_ceiling[k])
+        return True
+
+    def drive_less(self, k: int) -> bool:
+        """Segment ``k``'s pulse a step softer, down to ``DRIVE_MIN``, and never harder again; whether it moved."""
+        if not self.free_drive[k] or self.drive[k] <= DRIVE_MIN + 1e-9:
+            return False
+        self.drive[k] = max(self.drive[k] / DRIVE_STEP, DRIVE_MIN)
+        self.drive_ceiling[k] = self.drive[k]
+        return True
+
     def too_hard(self) -> bool:
-        """The presses of a round that was too hard become each one's ceiling less a step, and every free press
-        above 1 softens a step (not below 1); whether any moved."""
-        hard = np.array(self.free_press, bool) & (self.press > 1.0)
-        self.ceiling[hard] = np.minimum(self.ceiling[hard], np.maximum(self.press[hard] / PRESS_STEP, 1.0))
-        return soften(self.press, self.free_press)
+        """The presses and drives of a round that was too hard become each one's ceiling less a step, and every
+        free press and drive above 1 softens a step (not below 1); whether any moved."""
+        moved = False
+        for value, ceiling, free, step in ((self.press, self.ceiling, self.free_press, PRESS_STEP),
+                                           (self.drive, self.drive_ceiling, self.free_drive, DRIVE_STEP)):
+            hard = np.array(free, bool) & (value > 1.0)
+            ceiling[hard] = np.minimum(ceiling[hard], np.maximum(value[hard] / step, 1.0))
+            moved |= soften(value, free, step)
+        return moved
 
 
-def soften(press: np.ndarray, free: list[bool]) -> bool:
-    """Every free press above 1 a step softer (not below 1); whether any moved."""
+def soften(press: np.ndarray, free: list[bool], step: float = PRESS_STEP) -> bool:
+    """Every free press (or drive) above 1 a step softer (not below 1); whether any moved."""
     hard = np.array(free, bool) & (press > 1.0)
-    press[hard] = np.maximum(press[hard] / PRESS_STEP, 1.0)
+    press[hard] = np.maximum(press[hard] / step, 1.0)
     return bool(hard.any())
 
 
@@ -122,10 +154,12 @@ def leads_of(u, targets: list[TargetSpec | None], default_lead_ms: float) -> Lea
                 starts=np.array(u.starts_ms(), float), cap=cap, gap=gap, ceiling=np.full(len(segs), PRESS_MAX),
                 free_lead=[s.lead_ms is None for s in segs],
                 # a press the utterance gives (a glide's 1) is kept
-                free_press=["press" not in s.model_fields_set for s in segs])
+                free_press=["press" not in s.model_fields_set for s in segs],
+                drive=np.array([s.drive for s in segs], float), free_drive=["drive" not in s.model_fields_set
+                                                                            for s in segs])
     out.in_order()  # a short part (an affricate's release, a glide) leads no more than fits
     return out
 
 
-__all__ = ["LEAD_MAX_MS", "LEAD_STEP_MS", "Leads", "PRESS_MAX", "PRESS_STEP", "VOWEL_KEPT", "lead_bounds",
-           "leads_of", "soften"]
+__all__ = ["DRIVE_MAX", "DRIVE_MIN", "DRIVE_STEP", "LEAD_MAX_MS", "LEAD_STEP_MS", "Leads", "PRESS_MAX",
+           "PRESS_STEP", "VOWEL_KEPT", "lead_bounds", "leads_of", "soften"]

@@ -34,3 +34,4 @@ class Record:
     prepare_ms: float = 0.0
     leads_ms: np.ndarray = field(default_factory=lambda: np.zeros(0))  # (K,) each segment's own lead
     press: np.ndarray = field(default_factory=lambda: np.zeros(0))  # (K,) each segment's tongue-force factor
+    drive: np.ndarray = field(default_factory=lambda: np.zeros(0))  # (K,) each segment's opening pulse's factor

@@ -62,6 +62,7 @@ class Spoken:
     prepare_ms: float = 0.0  # the first segment's forces switch on this long before the sound (>= lead_ms)
     segment_lead_ms: np.ndarray = field(default_factory=lambda: np.zeros(0))  # (K,) each segment's own lead
     press: np.ndarray = field(default_factory=lambda: np.zeros(0))  # (K,) each segment's tongue-force factor
+    drive: np.ndarray = field(default_factory=lambda: np.zeros(0))  # (K,) each segment's opening pulse's factor
     air: dict[str, np.ndarray] = field(default_factory=dict)  # per frame: the cavity's pressure, flows, voice gain
 
 
@@ -164,7 +165,8 @@ def force_course(u: Utterance, p: Plan, model: Model, cfg: Config) -> Course:
                                  f"{', '.join(names)}")
         pairs = [(muscle_shares(model, a), muscle_shares(model, b)) for a, b in sp.pulse_antagonists]
         durations = np.diff(np.r_[starts, duration + prep])  # how long each segment's forces act
-        starts, sets = pulse_step(starts, durations, vectors, units.ms_to_s(sp.pulse_ms), sp.pulse_gain,
+        gains = sp.pulse_gain * np.array([seg.drive for seg in u.segments])
+        starts, sets = pulse_step(starts, durations, vectors, units.ms_to_s(sp.pulse_ms), gains,
                                   units.newton_to_dyn(cfg.muscles.max_force_n), pairs)
     force_at = course(starts, sets, ramp_s)
     if sp.activation_rise_ms > 0 or sp.activation_fall_ms > 0:
@@ -328,4 +330,5 @@ def speak_plan(u: Utterance, p: Plan, cfg: Config, model: Model, progress=None, 
                   timings_s=lap.times, segment_eps_cm=eps, beyond_wall_cm=beyond, force_course=c.how,
                   ramp_ms=units.s_to_ms(c.ramp_s), activation_ms=(sp.activation_rise_ms, sp.activation_fall_ms),
                   lead_ms=units.s_to_ms(c.lead_s), prepare_ms=units.s_to_ms(c.prep_s),
-                  segment_lead_ms=units.s_to_ms(c.leads_s), press=np.array([seg.press for seg in u.segments]))
+                  segment_lead_ms=units.s_to_ms(c.leads_s), press=np.array([seg.press for seg in u.segments]),
+                  drive=np.array([seg.drive for seg in u.segments]))

@@ -20,10 +20,14 @@ place read frame by frame, and the leads and presses moved by what was measured:
 * one still held more than ``HELD_MS`` after its end brings the next segment's switch forward by as long
   (a release on time: a stop's burst inside its interval, a voiced closure no longer than its voicing lasts).
 
-A round whose simulation is not physical (an inverted brick, a tongue off the tract's grid) is never kept, its
-presses become their ceilings less a step, and every press above 1 softens a step for the next; so after a round
-faster than a speaker moves (peak speeds beyond the EMA range + 50 %), which counts as missing the share it is
-too fast of every constriction's interval.  Leads keep their bounds (:mod:`.leads`: a segment after a vowel
+A vowel its forces do not lead near enough (see below) opens with a harder pulse in the next round (its
+``drive``, :mod:`.leads`).  A round whose simulation is not physical (an inverted brick, a tongue off the tract's
+grid) is never kept, its presses and drives become their ceilings less a step, and every press and drive above 1
+softens a step for the next.  A round faster than a speaker moves (peak speeds beyond the EMA range + 50 %)
+counts as missing the share it is too fast of every constriction's interval; the next round is the same with
+its presses and drives a step softer, or, nothing being above 1, with the pulse of the segment whose forces
+switched on last before the fastest movement softer; when the round so slowed is too fast again, it is corrected
+as any other and softened as well.  Leads keep their bounds (:mod:`.leads`: a segment after a vowel
 switches on no earlier than the vowel's middle until it may press no harder).  The rounds stop when nothing
 moves or every constriction is on time; of the rounds within the speed limits (any, when none is) the one that
 missed the fewest ms of its constrictions' intervals and of its vowels is the one kept (the corrections of a
@@ -81,6 +85,7 @@ class Timing:
     released_early_ms: dict[int, float]  # ... how long before its end it opened again
     held_late_ms: dict[int, float]  # ... how long after its end it still held
     trajectory: object = None  # the returned utterance's movement, when the last round simulated it as it is
+    drive: list[float] | None = None  # each segment's pulse factor (None: 1 each)
 
 
 def goals_of(targets: list[TargetSpec | None], cfg: Config) -> list[Goal]:
@@ -172,13 +177,12 @@ def vowel_eps(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: l
     return list(zip(ks, eps))
 
 
-def vowels_missed_ms(marks: list[tuple[int, np.ndarray]], starts: np.ndarray, ends: np.ndarray, traj, model: Model
-                     ) -> float:
-    """How much of the vowels a round missed (ms): each vowel's duration times how far (mean of the dorsum's and
-    the jaw's distance, over its middle half, beyond ``VOWEL_FREE_CM``, in ``VOWEL_CM``, at most 1) they stayed
-    from its EP."""
+def vowel_shares(marks: list[tuple[int, np.ndarray]], starts: np.ndarray, ends: np.ndarray, traj, model: Model
+                 ) -> dict[int, float]:
+    """Per vowel, the share of it a round missed: how far (mean of the dorsum's and the jaw's distance, over its
+    middle half, beyond ``VOWEL_FREE_CM``, in ``VOWEL_CM``, at most 1) they stayed from its EP."""
     pts = model.control_points()
-    out = 0.0
+    out = {}
     for k, ep in marks:
         a, b = starts[k] + 0.25 * (ends[k] - starts[k]), starts[k] + 0.75 * (ends[k] - starts[k])
         sel = (traj.time >= a / 1e3) & (traj.time <= b / 1e3)
@@ -186,8 +190,26 @@ def vowels_missed_ms(marks: list[tuple[int, np.ndarray]], starts: np.ndarray, en
             continue
         d = [np.linalg.norm(traj.x[sel, pts[n], :2] - ep[j, :2], axis=1) for j, n in ((1, "dorsum"), (2, "jaw"))]
         off = float(np.mean(0.5 * (d[0] + d[1]))) - VOWEL_FREE_CM
-        out += (ends[k] - starts[k]) * float(np.clip(off / VOWEL_CM, 0.0, 1.0))
+        out[k] = float(np.clip(off / VOWEL_CM, 0.0, 1.0))
     return out
+
+
+def vowels_missed_ms(marks: list[tuple[int, np.ndarray]], starts: np.ndarray, ends: np.ndarray, traj, model: Model
+                     ) -> float:
+    """How much of the vowels a round missed (ms): each vowel's duration times its share missed
+    (:func:`vowel_shares`)."""
+    return float(sum((ends[k] - starts[k]) * s for k, s in vowel_shares(marks, starts, ends, traj, model).items()))
+
+
+def fastest_switch(fast: dict[str, float], traj, model: Model, switches_ms: np.ndarray) -> int:
+    """The segment whose forces switched on (``switches_ms``, rising) last before the fastest movement of the
+    articulator most beyond its limit in ``fast`` (0 if none before it)."""
+    name = max(fast, key=fast.get)
+    x = traj.x[:, model.control_points()[name], :2]
+    speed = np.linalg.norm(np.diff(x, axis=0), axis=1) / np.diff(traj.time)
+    i = int(np.argmax(speed))
+    peak_ms = 1e3 * 0.5 * (traj.time[i] + traj.time[i + 1])
+    return max(int(np.searchsorted(switches_ms, peak_ms, side="right")) - 1, 0)
 
 
 def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[TargetSpec | None],
@@ -203,8 +225,9 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
     kn = leads_of(u, targets, default_leads_ms(u, cfg)[0])
     starts, ends = kn.starts, kn.starts + np.array([s.duration_ms for s in segs])
     best = prior = None
+    slowing = False  # the round before was slowed alone
     for r in range(rounds):
-        trial = with_leads(u, kn.leads, kn.press)
+        trial = with_leads(u, kn.leads, kn.press, kn.drive)
         try:
             traj, areas, prior = place_areas(trial, p, cfg, model, rest, goals, prior)
             bad = bool(problems(traj, model.volume_constraint))
@@ -215,7 +238,7 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
                 break
             continue
         t = traj.time
-        tried = kn.leads.copy(), kn.press.copy()
+        tried = kn.leads.copy(), kn.press.copy(), kn.drive.copy()
         late, early, held, soon = {}, {}, {}, {}
         changed = False
         for g in goals:
@@ -232,24 +255,38 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
             changed |= correct(kn, g, segs, t, area, (late[k], early[k], soon[k], held[k]), ends[k])
         kn.in_order()
         score = missed_ms(goals, late, early, starts, ends, areas, t)
-        score += vowels_missed_ms(marks, starts, ends, traj, model)
+        shares = vowel_shares(marks, starts, ends, traj, model)
+        score += sum((ends[k] - starts[k]) * v for k, v in shares.items())
         score += sum(max(h - HELD_MS, 0.0) for h in held.values()) + sum(max(a - EARLY_MS, 0.0) for a in soon.values())
         fast = too_fast(peak_speeds(t, {n: traj.x[:, i] for n, i in model.control_points().items()}))
-        if fast:  # too fast: as bad as missing that share more of every constriction's interval; presses softer
+        slowed = False
+        if fast:  # too fast: as bad as missing that share more of every constriction's interval
             score += (max(fast.values()) - 1.0) * sum(ends[g.segment] - starts[g.segment] for g in goals)
-            changed |= kn.too_hard()
+            corrected = kn.leads.copy(), kn.press.copy(), kn.drive.copy()
+            if not slowing:  # first the round as it was, its presses and drives softer, its leads kept
+                kn.leads, kn.press, kn.drive = (a.copy() for a in tried)
+                slowed = kn.too_hard() or kn.drive_less(fastest_switch(fast, traj, model, starts - kn.leads))
+            if slowed:
+                changed = True
+            else:  # ... then, when that did not do, corrected as any round, and softer
+                kn.leads, kn.press, kn.drive = corrected
+                changed |= kn.too_hard()
+        else:  # a vowel not reached: its pulse harder
+            for k, v in shares.items():
+                changed |= v > 0 and kn.drive_more(k)
         key = (bool(fast), score)  # a round within the speed limits before any beyond them
         if best is None or key < best[0]:
             best = (key, r, tried, late, early, held, traj)
-        changed &= not (np.array_equal(kn.leads, tried[0]) and np.array_equal(kn.press, tried[1]))  # all at a bound
+        changed &= not all(np.array_equal(a, b) for a, b in zip((kn.leads, kn.press, kn.drive), tried))  # all bound
+        slowing = slowed
         if not changed or score == 0.0:
             break
     if best is None:  # no round was physical: the last, for the caller to refuse
-        return with_leads(u, kn.leads, kn.press), None
-    _, _, (leads, press), late, early, held, traj = best
-    return with_leads(u, leads, press), Timing(leads_ms=leads.tolist(), press=press.tolist(), rounds=r + 1,
-                                               onset_late_ms=late, released_early_ms=early, held_late_ms=held,
-                                               trajectory=traj)
+        return with_leads(u, kn.leads, kn.press, kn.drive), None
+    _, _, (leads, press, drive), late, early, held, traj = best
+    return with_leads(u, leads, press, drive), Timing(leads_ms=leads.tolist(), press=press.tolist(), rounds=r + 1,
+                                                      onset_late_ms=late, released_early_ms=early,
+                                                      held_late_ms=held, trajectory=traj, drive=drive.tolist())
 
 
 def correct(kn: Leads, g: Goal, segs, t: np.ndarray, area: np.ndarray, measured: tuple, end_ms: float) -> bool:
@@ -303,10 +340,12 @@ def missed_ms(goals: list[Goal], late: dict, early: dict, starts: np.ndarray, en
     return float(out)
 
 
-def with_leads(u: Utterance, leads, press) -> Utterance:
-    """The utterance with each segment's lead (ms) and press."""
-    segs = [s.model_copy(update={"lead_ms": round(float(a), 3), "press": round(float(b), 4)})
-            for s, a, b in zip(u.segments, leads, press)]
+def with_leads(u: Utterance, leads, press, drive=None) -> Utterance:
+    """The utterance with each segment's lead (ms), press and drive (None: each its own)."""
+    drive = [s.drive for s in u.segments] if drive is None else drive
+    segs = [s.model_copy(update={"lead_ms": round(float(a), 3), "press": round(float(b), 4),
+                                 "drive": round(float(c), 4)})
+            for s, a, b, c in zip(u.segments, leads, press, drive)]
     return u.model_copy(update={"segments": segs})
 
 

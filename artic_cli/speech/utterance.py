@@ -24,7 +24,9 @@ Example::
 A segment's ``lead_ms`` overrides the utterance's for its forces alone (a stop's closing gesture starts earlier,
 its release comes with the next segment's forces); ``press`` scales a solved target's tongue-muscle forces, up
 to ``muscles.max_force_n`` (a stop presses on the wall: a virtual target beyond it; the jaw's forces are kept;
-below 1 it softens them, as a channel too narrow needs).
+below 1 it softens them, as a channel too narrow needs); ``drive`` scales the pulse that opens the segment's
+forces in the pulse-step course (``speech.pulse_gain`` x this: above 1 a vowel too short to be reached otherwise
+gets there sooner, below 1 a movement faster than a speaker's is slowed).
 
 A target path is read relative to the working folder, else to the utterance file's folder.
 """
@@ -59,6 +61,7 @@ class Segment(Strict):
     label: SafeName | None = None  # the TextGrid's label (default: the target's name)
     lead_ms: Annotated[float, Field(ge=0, le=300, allow_inf_nan=False)] | None = None  # else the utterance's
     press: Annotated[float, Field(ge=0.5, le=3, allow_inf_nan=False)] = 1.0  # the target's tongue forces x this (below 1: softer)
+    drive: Annotated[float, Field(ge=0, le=4, allow_inf_nan=False)] = 1.0  # its opening pulse's gain x this
 
     @model_validator(mode="after")
     def _one_source(self):

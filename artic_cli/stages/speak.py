@@ -103,6 +103,8 @@ def write(wav: Path | str, s: Spoken, prov=None) -> dict[str, Path]:
         g.create_dataset("lead", data=s.segment_lead_ms).attrs["units"] = ("ms: each segment's forces switch on this "
                                                                           "long before its sound")
         g.create_dataset("press", data=s.press).attrs["units"] = "factor on the solved target's tongue-muscle forces"
+        g.create_dataset("drive", data=s.drive).attrs["units"] = ("factor on the pulse that opens the segment's "
+                                                                  "forces (speech.pulse_gain x this)")
         g.create_dataset("lip_area", data=np.array([a for a, _ in p.lips])).attrs["units"] = "cm^2"
         g.create_dataset("lip_length", data=np.array([b for _, b in p.lips])).attrs["units"] = "cm"
         names = sorted({m for f_ in p.forces_n for m in f_})
@@ -163,7 +165,8 @@ def read(path: Path | str) -> Record:
                           # records from before segments had their own lead and press: the utterance's, none
                           leads_ms=g["lead"][()] if "lead" in g else np.full(len(g["label"]),
                                                                              float(g.attrs.get("lead_ms", 0.0))),
-                          press=g["press"][()] if "press" in g else np.ones(len(g["label"])))
+                          press=g["press"][()] if "press" in g else np.ones(len(g["label"])),
+                          drive=g["drive"][()] if "drive" in g else np.ones(len(g["label"])))
         except (KeyError, ValueError, OSError) as err:
             raise ArticError(f"{path} is damaged or incomplete ({type(err).__name__}); {STAGE.hint}") from None
 
@@ -255,7 +258,8 @@ def speak(utterance: Path | str | Utterance, out: Path | str | None = None, maps
     if timing is not None and say:
         how = f"{timing.rounds} round(s)" if timing.rounds else "as found before"
         say(f"timing: {how}; leads {', '.join(f'{v:.0f}' for v in timing.leads_ms)} ms; "
-            f"presses {', '.join(f'{v:.2f}' for v in timing.press)}")
+            f"presses {', '.join(f'{v:.2f}' for v in timing.press)}; "
+            f"drives {', '.join(f'{v:.2f}' for v in timing.drive)}")
     s = speak_plan(u, p, view, model, progress, rest, timing.trajectory if timing is not None else None,
                    caches["ep"])
     written = write(out, s, prov)
@@ -283,13 +287,16 @@ def timed_once(u: Utterance, p: Plan, cfg: Config, model, rest, targets, cache: 
            "durations": p.durations_s, "config": sections_hash(cfg, STAGE.sections),
            "code": code_hash("artic_cli.speech.timing")}
     hit = cache.get(key)
-    if hit is not None and hit.get("leads_ms", np.zeros(0)).shape == (len(u.segments),) == hit["press"].shape:
-        return with_leads(u, hit["leads_ms"], hit["press"]), Timing(
+    n = (len(u.segments),)
+    if hit is not None and hit.get("leads_ms", np.zeros(0)).shape == n == hit["press"].shape == hit.get(
+            "drive", np.zeros(0)).shape:
+        return with_leads(u, hit["leads_ms"], hit["press"], hit["drive"]), Timing(
             leads_ms=hit["leads_ms"].tolist(), press=hit["press"].tolist(), rounds=0, onset_late_ms={},
-            released_early_ms={}, held_late_ms={})
+            released_early_ms={}, held_late_ms={}, drive=hit["drive"].tolist())
     out, timing = timed(u, p, cfg, model, rest, targets, known=known)
     if timing is not None:
-        cache.put(key, {"leads_ms": np.asarray(timing.leads_ms, float), "press": np.asarray(timing.press, float)})
+        cache.put(key, {"leads_ms": np.asarray(timing.leads_ms, float), "press": np.asarray(timing.press, float),
+                        "drive": np.asarray(timing.drive, float)})
     return out, timing
 
 

@@ -7,7 +7,8 @@ from types import SimpleNamespace as NS
 import numpy as np
 import pytest
 
-from artic_cli.speech.leads import LEAD_MAX_MS, LEAD_STEP_MS, PRESS_MAX, PRESS_STEP, Leads, lead_bounds
+from artic_cli.speech.leads import (DRIVE_MAX, DRIVE_MIN, DRIVE_STEP, LEAD_MAX_MS, LEAD_STEP_MS, PRESS_MAX, PRESS_STEP,
+                                    Leads, lead_bounds)
 from artic_cli.speech.measures import SPEED_MARGIN, peak_speeds, too_fast
 
 VOWEL, CONSONANT = NS(acoustic=object()), NS(acoustic=None)
@@ -66,3 +67,31 @@ def test_peak_speeds_and_the_articulators_too_fast():
     assert sp == {"tip": pytest.approx(100.0), "dorsum": 0.0}
     fast = too_fast(dict(sp, jaw=0.0))
     assert list(fast) == ["tip"] and fast["tip"] == pytest.approx(100.0 / (SPEED_MARGIN * 40.0))
+
+
+def test_a_vowel_drives_harder_up_to_its_ceiling_and_a_drive_found_too_hard_is_never_reached_again():
+    kn = knobs()
+    assert kn.drive.tolist() == [1.0, 1.0]
+    steps = 0
+    while kn.drive_more(1):
+        steps += 1
+    assert kn.drive[1] == pytest.approx(DRIVE_MAX) and steps == int(np.ceil(np.log(DRIVE_MAX) / np.log(DRIVE_STEP)))
+    assert kn.too_hard()  # a round too fast: the drive a step softer, its ceiling there
+    assert kn.drive[1] == pytest.approx(DRIVE_MAX / DRIVE_STEP) and not kn.drive_more(1)
+    while kn.too_hard():
+        pass
+    assert kn.drive[1] == 1.0 and kn.press.tolist() == [1.0, 1.0]  # softened to 1, not below
+
+
+def test_a_movement_too_fast_with_nothing_pressed_slows_its_segments_pulse_for_good():
+    kn = knobs()
+    assert not kn.too_hard()  # nothing above 1 to soften
+    assert kn.drive_less(1) and kn.drive[1] == pytest.approx(1.0 / DRIVE_STEP)
+    assert not kn.drive_more(1)  # never harder again
+    while kn.drive_less(1):
+        pass
+    assert kn.drive[1] == pytest.approx(DRIVE_MIN)
+    given = Leads(leads=np.array([100.0]), press=np.ones(1), starts=np.zeros(1), cap=np.array([LEAD_MAX_MS]),
+                  gap=np.array([10.0]), ceiling=np.full(1, PRESS_MAX), free_lead=[True], free_press=[True],
+                  free_drive=[False])
+    assert not given.drive_more(0) and not given.drive_less(0)  # a drive the utterance gives is kept

@@ -164,6 +164,6 @@ def test_no_utterance_or_phoneme_entry_in_configs_types_forces_a_press_or_a_lead
     root = Path(__file__).resolve().parents[2] / "configs"
     files = sorted((root / "utterances").glob("*.yaml")) + sorted((root / "phonemes").glob("*.yaml"))
     assert len(files) >= 43  # 42 utterances and the inventory
-    typed = {f.name: sorted(set(_keys(yaml.safe_load(f.read_text()))) & {"forces_n", "press", "lead_ms"})
+    typed = {f.name: sorted(set(_keys(yaml.safe_load(f.read_text()))) & {"forces_n", "press", "lead_ms", "drive"})
              for f in files}
     assert {k: v for k, v in typed.items() if v} == {}

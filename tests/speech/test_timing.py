@@ -108,3 +108,17 @@ def test_a_vowel_is_missed_by_how_far_its_dorsum_and_jaw_stay_from_its_ep():
     late = x.copy()
     late[time >= 0.080, 1, 1] = 5.0  # off only after its middle half (25-75 ms): not missed
     assert vowels_missed_ms([(0, ep)], starts, ends, SimpleNamespace(time=time, x=late), _Points()) == 0.0
+
+
+def test_the_segment_slowed_is_the_one_switched_on_last_before_the_fastest_movement():
+    from types import SimpleNamespace as NS
+
+    from artic_cli.speech.timing import fastest_switch
+    t = np.arange(0.0, 0.5, 0.005)
+    x = np.zeros((len(t), 2, 3))
+    x[:, 0, 0] = np.clip((t - 0.30) / 0.02, 0.0, 1.0)  # the tip moves 1 cm in 20 ms from 300 ms
+    x[:, 1, 0] = 0.5 - 0.5 * np.cos(np.pi * np.clip((t - 0.10) / 0.10, 0.0, 1.0))  # the dorsum fastest at 150 ms
+    model = NS(control_points=lambda: {"tip": 0, "dorsum": 1})
+    switches = np.array([-100.0, 80.0, 250.0, 320.0])
+    assert fastest_switch({"tip": 1.2}, NS(time=t, x=x), model, switches) == 2  # switched on at 250 ms
+    assert fastest_switch({"dorsum": 1.1, "tip": 1.05}, NS(time=t, x=x), model, switches) == 1

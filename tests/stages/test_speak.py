@@ -300,6 +300,17 @@ def test_a_pulse_step_course_opens_each_segment_with_a_clipped_pulse():
     assert sets.tolist() == [[6.0, 0.0], [4.0, 0.0], [0.0, 6.0], [1.0, 3.0]]  # 4 + 4 capped at 6; 1 - 3 at 0
 
 
+def test_each_segment_may_open_with_its_own_pulse_gain():
+    from artic_cli.speech.course import pulse_step
+
+    v = np.array([[4.0, 0.0], [1.0, 3.0], [1.0, 1.0]])
+    _, sets = pulse_step([0.0, 0.2, 0.4], [0.2, 0.2, 0.2], v, 0.04, np.array([1.0, 0.5, 0.0]), 9.0)
+    assert sets[2].tolist() == [0.0, 4.5] and sets[3].tolist() == [1.0, 3.0]  # 1 + 0.5 (1 - 4) clipped; 3 + 1.5
+    assert sets[4].tolist() == sets[5].tolist() == [1.0, 1.0]  # a gain of 0: no pulse, the step alone
+    _, one = pulse_step([0.0, 0.2, 0.4], [0.2, 0.2, 0.2], v, 0.04, 0.5, 9.0)
+    assert one[2].tolist() == sets[2].tolist()  # one gain for all is the same as each its own
+
+
 def test_a_jaw_pulse_below_zero_drives_the_closers():
     from artic_cli.speech.course import pulse_step
 
