@@ -111,12 +111,13 @@ class Leads:
         self.drive_ceiling[k] = self.drive[k]
         return True
 
-    def too_hard(self) -> bool:
-        """The presses and drives of a round that was too hard become each one's ceiling less a step, and every
-        free press and drive above 1 softens a step (not below 1); whether any moved."""
+    def too_hard(self, drives: bool = True) -> bool:
+        """The presses (and ``drives``) of a round that was too hard become each one's ceiling less a step, and
+        every free one above 1 softens a step (not below 1); whether any moved."""
         moved = False
         for value, ceiling, free, step in ((self.press, self.ceiling, self.free_press, PRESS_STEP),
-                                           (self.drive, self.drive_ceiling, self.free_drive, DRIVE_STEP)):
+                                           (self.drive, self.drive_ceiling, self.free_drive, DRIVE_STEP))[
+                                               :2 if drives else 1]:
             hard = np.array(free, bool) & (value > 1.0)
             ceiling[hard] = np.minimum(ceiling[hard], np.maximum(value[hard] / step, 1.0))
             moved |= soften(value, free, step)

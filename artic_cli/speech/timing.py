@@ -25,9 +25,9 @@ A vowel its forces do not lead near enough (see below) opens with a harder pulse
 grid) is never kept, its presses and drives become their ceilings less a step, and every press and drive above 1
 softens a step for the next.  A round faster than a speaker moves (peak speeds beyond the EMA range + 50 %)
 counts as missing the share it is too fast of every constriction's interval; the next round is the same with
-its presses and drives a step softer, or, nothing being above 1, with the pulse of the segment whose forces
-switched on last before the fastest movement softer; when the round so slowed is too fast again, it is corrected
-as any other and softened as well.  Leads keep their bounds (:mod:`.leads`: a segment after a vowel
+its presses a step softer, or, no press being above 1, with the pulse of the segment whose forces switched on
+last before the fastest movement softer (the vowels' drives are kept: they are what reaches the vowels); when the
+round so slowed is too fast again, it is corrected as any other, its presses and that pulse softer as well.  Leads keep their bounds (:mod:`.leads`: a segment after a vowel
 switches on no earlier than the vowel's middle until it may press no harder).  The rounds stop when nothing
 moves or every constriction is on time; of the rounds within the speed limits (any, when none is) the one that
 missed the fewest ms of its constrictions' intervals and of its vowels is the one kept (the corrections of a
@@ -263,14 +263,15 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
         if fast:  # too fast: as bad as missing that share more of every constriction's interval
             score += (max(fast.values()) - 1.0) * sum(ends[g.segment] - starts[g.segment] for g in goals)
             corrected = kn.leads.copy(), kn.press.copy(), kn.drive.copy()
-            if not slowing:  # first the round as it was, its presses and drives softer, its leads kept
+            culprit = fastest_switch(fast, traj, model, starts - tried[0])
+            if not slowing:  # first the round as it was, its presses softer, else its fastest movement's pulse
                 kn.leads, kn.press, kn.drive = (a.copy() for a in tried)
-                slowed = kn.too_hard() or kn.drive_less(fastest_switch(fast, traj, model, starts - kn.leads))
+                slowed = kn.too_hard(drives=False) or kn.drive_less(culprit)
             if slowed:
                 changed = True
             else:  # ... then, when that did not do, corrected as any round, and softer
                 kn.leads, kn.press, kn.drive = corrected
-                changed |= kn.too_hard()
+                changed |= kn.too_hard(drives=False) | kn.drive_less(culprit)
         else:  # a vowel not reached: its pulse harder
             for k, v in shares.items():
                 changed |= v > 0 and kn.drive_more(k)

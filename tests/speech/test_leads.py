@@ -95,3 +95,13 @@ def test_a_movement_too_fast_with_nothing_pressed_slows_its_segments_pulse_for_g
                   gap=np.array([10.0]), ceiling=np.full(1, PRESS_MAX), free_lead=[True], free_press=[True],
                   free_drive=[False])
     assert not given.drive_more(0) and not given.drive_less(0)  # a drive the utterance gives is kept
+
+
+def test_a_round_too_fast_softens_its_presses_and_keeps_its_drives():
+    kn = knobs(press=1.5)
+    kn.drive[1] = 2.0
+    assert kn.too_hard(drives=False)
+    assert kn.press[1] == pytest.approx(1.5 / PRESS_STEP) and kn.drive[1] == pytest.approx(2.0)
+    kn.press[:] = 1.0
+    assert not kn.too_hard(drives=False)  # no press above 1: the drive is the culprit's to soften
+    assert kn.drive[1] == pytest.approx(2.0)
