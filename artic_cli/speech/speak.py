@@ -274,13 +274,21 @@ def formant_tracks(tracts: Tracts, time_s: np.ndarray, cfg: Config) -> np.ndarra
     sp = cfg.speech
     stride = max(1, int(round(sp.formant_frame_ms / sp.frame_ms)))
     picked = np.unique(np.r_[np.arange(0, tracts.n_frames, stride), tracts.n_frames - 1])
-    tubes = [Tube(tracts.af.length_cm[k], tracts.af.area_cm2[k]) for k in picked]
-    ac = analyse(tubes, cfg.acoustics, velum_area_cm2=tracts.controls["velum_port_cm2"][picked],
-                 port_from_glottis_cm=port_positions(tracts)[picked], spectra=False, bandwidths=False)
-    formants_hz = np.stack([np.interp(time_s, time_s[picked], ac.formants_hz[:, j])
-                            for j in range(ac.formants_hz.shape[1])], axis=1)
+    at = formants_at(tracts, picked, cfg)
+    formants_hz = np.stack([np.interp(time_s, time_s[picked], at[:, j]) for j in range(at.shape[1])], axis=1)
     formants_hz[tracts.af.area_cm2.min(axis=1) <= 0] = np.nan  # a closed tract has none
     return formants_hz
+
+
+def formants_at(tracts: Tracts, frames: np.ndarray, cfg: Config) -> np.ndarray:
+    """(len(frames), K) formants (Hz) of the tract at the frames ``frames`` (their ports open as the course has
+    them); NaN where the tract is closed."""
+    tubes = [Tube(tracts.af.length_cm[k], tracts.af.area_cm2[k]) for k in frames]
+    ac = analyse(tubes, cfg.acoustics, velum_area_cm2=tracts.controls["velum_port_cm2"][frames],
+                 port_from_glottis_cm=port_positions(tracts)[frames], spectra=False, bandwidths=False)
+    out = np.array(ac.formants_hz, float)
+    out[tracts.af.area_cm2[frames].min(axis=1) <= 0] = np.nan
+    return out
 
 
 def sound(u: Utterance, p: Plan, tracts: Tracts, time_s: np.ndarray, duration_s: float, cfg: Config

@@ -20,7 +20,7 @@ place read frame by frame, and the leads and presses moved by what was measured:
 * one still held more than ``HELD_MS`` after its end brings the next segment's switch forward by as long
   (a release on time: a stop's burst inside its interval, a voiced closure no longer than its voicing lasts).
 
-A vowel its forces do not lead near enough (see below) opens with a harder pulse in the next round (its
+A vowel not heard near enough its formants (see below) opens with a harder pulse in the next round (its
 ``drive``, :mod:`.leads`).  A round whose simulation is not physical (an inverted brick, a tongue off the tract's
 grid) is never kept, its presses and drives become their ceilings less a step, and every press and drive above 1
 softens a step for the next.  A round faster than a speaker moves (peak speeds beyond the EMA range + 50 %)
@@ -32,8 +32,8 @@ switches on no earlier than the vowel's middle until it may press no harder).  T
 moves or every constriction is on time; of the rounds within the speed limits (any, when none is) the one that
 missed the fewest ms of its constrictions' intervals and of its vowels is the one kept (the corrections of a
 closure and of the channel after it can swing), with what it measured.  A vowel counts as missed by as much
-of its duration as its dorsum and jaw stay, over its middle half, beyond ``VOWEL_FREE_CM`` from where its
-forces lead them (its EP), a share growing to all of it ``VOWEL_CM`` further: a consonant that leads so far
+of its duration as its F1 or F2 (the tract's own, over its middle half) stay beyond its tolerance from its
+formant goal, a share growing to all of it ``VOWEL_SPAN`` tolerances further: a consonant that leads so far
 into a vowel that the vowel is not heard costs that vowel.
 """
 
@@ -43,7 +43,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import units
 from ..config import Config
 from ..control.solver import TargetSpec
 from ..errors import OffGrid
@@ -54,7 +53,7 @@ from ..tract.speaker import speaker_tract
 from .leads import LEAD_STEP_MS, Leads, leads_of
 from .measures import peak_speeds, too_fast
 from .plan import Plan
-from .speak import (course_trajectory, default_leads_ms, equilibria, force_course, segment_vectors,
+from .speak import (course_trajectory, default_leads_ms, force_course, formants_at,
                     tracts_of_run)
 from .utterance import Utterance
 
@@ -63,9 +62,9 @@ SLACK_MS = 3.0  # reached within this of the start, held to within this of the e
 WINDOW_MS = 20.0  # a constriction made this long before its interval counts as reached at its start
 HELD_MS = 15.0  # a constriction held longer than this past its interval's end: the next segment leads more
 EARLY_MS = 40.0  # ... made longer than this before its start: its own segment leads less
-# a vowel whose dorsum and jaw stay (mean) within VOWEL_FREE_CM of its EP over its middle half is made, one more
-# than VOWEL_CM further off missed whole
-VOWEL_FREE_CM, VOWEL_CM = 0.4, 0.6
+# a vowel's F1 and F2 are read at VOWEL_FRAMES frames of its middle half; one further than its tolerance from its
+# goal misses a share of itself, all of it VOWEL_SPAN tolerances further
+VOWEL_FRAMES, VOWEL_SPAN = 5, 2.0
 
 
 @dataclass
@@ -115,7 +114,7 @@ def place_areas(u: Utterance, p: Plan, cfg: Config, model: Model, rest, goals: l
     traj = course_trajectory(model, c, cfg, rest, prior=prior, resumable=True)
     tracts = tracts_of_run(u, p, model, traj, cfg)
     region, _ = section_places(speaker_tract(cfg))
-    return traj, {g.segment: place_area(tracts.af.area_cm2, region, g.place) for g in goals}, (c, traj)
+    return traj, {g.segment: place_area(tracts.af.area_cm2, region, g.place) for g in goals}, (c, traj), tracts
 
 
 def made(area: np.ndarray, reach: float, floor: float = 0.0) -> np.ndarray:
@@ -164,41 +163,25 @@ def made_before(t: np.ndarray, area: np.ndarray, reach: float, start: float, flo
     return 1e3 * max(start - first, 0.0)
 
 
-def vowel_eps(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[TargetSpec | None],
-              known=None) -> list[tuple[int, np.ndarray]]:
-    """(segment, its EP: tip, dorsum, jaw (3, 3) cm) of each vowel (a segment with an acoustic target): where its
-    forces lead (:func:`..speak.equilibria`; ``known``: their cache)."""
-    ks = [k for k, t in enumerate(targets) if t is not None and t.acoustic is not None]
-    if not ks:
-        return []
-    vectors = segment_vectors(u, p, model, cfg.muscles.max_force_n)[ks]
-    eps = equilibria(model, rest, vectors, units.ms_to_s(cfg.speech.reach_hold_ms),
-                     units.ms_to_s(cfg.simulation.dt_ms), known)
-    return list(zip(ks, eps))
-
-
-def vowel_shares(marks: list[tuple[int, np.ndarray]], starts: np.ndarray, ends: np.ndarray, traj, model: Model
+def heard_shares(vowels: list, starts: np.ndarray, ends: np.ndarray, tracts, time_s: np.ndarray, cfg: Config
                  ) -> dict[int, float]:
-    """Per vowel, the share of it a round missed: how far (mean of the dorsum's and the jaw's distance, over its
-    middle half, beyond ``VOWEL_FREE_CM``, in ``VOWEL_CM``, at most 1) they stayed from its EP."""
-    pts = model.control_points()
+    """Per vowel (segment, its acoustic goal), the share of it a round missed: how far its F1 or F2 (medians of
+    ``VOWEL_FRAMES`` frames over its middle half) stay beyond its tolerance, in ``VOWEL_SPAN`` tolerances, at most 1
+    (a tract closed in most of them: 1)."""
     out = {}
-    for k, ep in marks:
+    for k, goal in vowels:
         a, b = starts[k] + 0.25 * (ends[k] - starts[k]), starts[k] + 0.75 * (ends[k] - starts[k])
-        sel = (traj.time >= a / 1e3) & (traj.time <= b / 1e3)
-        if not sel.any() or not np.all(np.isfinite(ep)):
+        inside = np.flatnonzero((time_s >= a / 1e3) & (time_s <= b / 1e3))
+        if not len(inside):
             continue
-        d = [np.linalg.norm(traj.x[sel, pts[n], :2] - ep[j, :2], axis=1) for j, n in ((1, "dorsum"), (2, "jaw"))]
-        off = float(np.mean(0.5 * (d[0] + d[1]))) - VOWEL_FREE_CM
-        out[k] = float(np.clip(off / VOWEL_CM, 0.0, 1.0))
+        frames = inside[np.unique(np.linspace(0, len(inside) - 1, VOWEL_FRAMES).round().astype(int))]
+        f = formants_at(tracts, frames, cfg)[:, :2]
+        if np.mean(np.isfinite(f[:, 0])) < 0.5:
+            out[k] = 1.0
+            continue
+        off = np.abs(np.nanmedian(f, axis=0) / np.asarray(goal.formants_hz[:2], float) - 1.0) / goal.tolerance
+        out[k] = float(np.clip((off.max() - 1.0) / VOWEL_SPAN, 0.0, 1.0))
     return out
-
-
-def vowels_missed_ms(marks: list[tuple[int, np.ndarray]], starts: np.ndarray, ends: np.ndarray, traj, model: Model
-                     ) -> float:
-    """How much of the vowels a round missed (ms): each vowel's duration times its share missed
-    (:func:`vowel_shares`)."""
-    return float(sum((ends[k] - starts[k]) * s for k, s in vowel_shares(marks, starts, ends, traj, model).items()))
 
 
 def fastest_switch(fast: dict[str, float], traj, model: Model, switches_ms: np.ndarray) -> int:
@@ -213,7 +196,7 @@ def fastest_switch(fast: dict[str, float], traj, model: Model, switches_ms: np.n
 
 
 def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[TargetSpec | None],
-          rounds: int = ROUNDS, known=None) -> tuple[Utterance, Timing | None]:
+          rounds: int = ROUNDS) -> tuple[Utterance, Timing | None]:
     """The utterance with the leads and presses its constrictions need (see the module's text); unchanged, with
     no timing, when it asks for no constriction."""
     goals = goals_of(targets, cfg)
@@ -221,7 +204,7 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
         return u, None
     segs = u.segments
     joined = joined_goals(goals)
-    marks = vowel_eps(u, p, cfg, model, rest, targets, known)
+    heard = [(k, t.acoustic) for k, t in enumerate(targets) if t is not None and t.acoustic is not None]
     kn = leads_of(u, targets, default_leads_ms(u, cfg)[0])
     starts, ends = kn.starts, kn.starts + np.array([s.duration_ms for s in segs])
     best = prior = None
@@ -229,7 +212,7 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
     for r in range(rounds):
         trial = with_leads(u, kn.leads, kn.press, kn.drive)
         try:
-            traj, areas, prior = place_areas(trial, p, cfg, model, rest, goals, prior)
+            traj, areas, prior, tracts = place_areas(trial, p, cfg, model, rest, goals, prior)
             bad = bool(problems(traj, model.volume_constraint))
         except OffGrid:  # the tongue left the tract's grid
             bad = True
@@ -255,7 +238,7 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
             changed |= correct(kn, g, segs, t, area, (late[k], early[k], soon[k], held[k]), ends[k])
         kn.in_order()
         score = missed_ms(goals, late, early, starts, ends, areas, t)
-        shares = vowel_shares(marks, starts, ends, traj, model)
+        shares = heard_shares(heard, starts, ends, tracts, traj.time, cfg)
         score += sum((ends[k] - starts[k]) * v for k, v in shares.items())
         score += sum(max(h - HELD_MS, 0.0) for h in held.values()) + sum(max(a - EARLY_MS, 0.0) for a in soon.values())
         fast = too_fast(peak_speeds(t, {n: traj.x[:, i] for n, i in model.control_points().items()}))

@@ -254,7 +254,7 @@ def speak(utterance: Path | str | Utterance, out: Path | str | None = None, maps
     view = STAGE.view(cfg)
     p = plan(u, view, targets, solve, accept_nearest, say)
     rest = rest_posture(model, caches["rest"])
-    u, timing = timed_once(u, p, view, model, rest, targets, caches["timing"], caches["ep"])
+    u, timing = timed_once(u, p, view, model, rest, targets, caches["timing"])
     if timing is not None and say:
         how = f"{timing.rounds} round(s)" if timing.rounds else "as found before"
         say(f"timing: {how}; leads {', '.join(f'{v:.0f}' for v in timing.leads_ms)} ms; "
@@ -277,7 +277,7 @@ def articulator(cfg: Config, m, cache: ResultCache):
     return model
 
 
-def timed_once(u: Utterance, p: Plan, cfg: Config, model, rest, targets, cache: ResultCache, known=None):
+def timed_once(u: Utterance, p: Plan, cfg: Config, model, rest, targets, cache: ResultCache):
     """:func:`timed`, its leads and presses kept in ``cache`` by what they hang on (the utterance but its name
     and pitch, the plan, the config, the timing's code), so that the same utterance at another pitch or under
     another name is not timed again: (the utterance with its leads and presses, its timing; rounds 0 when
@@ -293,7 +293,7 @@ def timed_once(u: Utterance, p: Plan, cfg: Config, model, rest, targets, cache: 
         return with_leads(u, hit["leads_ms"], hit["press"], hit["drive"]), Timing(
             leads_ms=hit["leads_ms"].tolist(), press=hit["press"].tolist(), rounds=0, onset_late_ms={},
             released_early_ms={}, held_late_ms={}, drive=hit["drive"].tolist())
-    out, timing = timed(u, p, cfg, model, rest, targets, known=known)
+    out, timing = timed(u, p, cfg, model, rest, targets)
     if timing is not None:
         cache.put(key, {"leads_ms": np.asarray(timing.leads_ms, float), "press": np.asarray(timing.press, float),
                         "drive": np.asarray(timing.drive, float)})

@@ -81,33 +81,36 @@ def test_a_geminate_and_its_consonant_are_one_constriction():
     assert joined_goals([Goal(2, 4, 0.01), Goal(3, 4, 0.13, 0.07)]) == set()  # a closure, then a channel
 
 
-class _Points:
-    """The one thing the vowel measure asks of a model: which nodes are the control points."""
+def test_a_vowel_is_missed_by_how_far_its_formants_stay_beyond_its_tolerance(monkeypatch):
+    import artic_cli.speech.timing as timing
+    from artic_cli.control.solver import AcousticGoal
+    from artic_cli.speech.timing import VOWEL_SPAN, heard_shares
 
-    def control_points(self):
-        return {"tip": 0, "dorsum": 1, "jaw": 2}
-
-
-def test_a_vowel_is_missed_by_how_far_its_dorsum_and_jaw_stay_from_its_ep():
-    from types import SimpleNamespace
-
-    from artic_cli.speech.timing import VOWEL_CM, VOWEL_FREE_CM, vowels_missed_ms
     time = np.arange(0.0, 0.2, 0.005)
-    ep = np.zeros((3, 3))
-    x = np.zeros((len(time), 3, 3))
+    goal = AcousticGoal(formants_hz=[750.0, 1400.0], tolerance_pct=[10.0, 7.0])
     starts, ends = np.array([0.0, 100.0]), np.array([100.0, 200.0])
-    at_ep = SimpleNamespace(time=time, x=x)
-    assert vowels_missed_ms([(0, ep)], starts, ends, at_ep, _Points()) == 0.0
-    off = x.copy()
-    off[:, 1, 1] = off[:, 2, 1] = VOWEL_FREE_CM + 0.5 * VOWEL_CM  # dorsum and jaw half way past the free band
-    assert vowels_missed_ms([(0, ep)], starts, ends, SimpleNamespace(time=time, x=off), _Points()) == \
-        pytest.approx(50.0)
-    off[:, 1, 1] = off[:, 2, 1] = 5.0  # far off: the whole vowel
-    assert vowels_missed_ms([(0, ep)], starts, ends, SimpleNamespace(time=time, x=off), _Points()) == \
-        pytest.approx(100.0)
-    late = x.copy()
-    late[time >= 0.080, 1, 1] = 5.0  # off only after its middle half (25-75 ms): not missed
-    assert vowels_missed_ms([(0, ep)], starts, ends, SimpleNamespace(time=time, x=late), _Points()) == 0.0
+    heard = {"f": None, "frames": None}
+
+    def formants_at(tracts, frames, cfg):
+        heard["frames"] = frames
+        return heard["f"][frames]
+
+    monkeypatch.setattr(timing, "formants_at", formants_at)
+
+    def share(f1, f2):
+        heard["f"] = np.tile([f1, f2, 2500.0], (len(time), 1))
+        return heard_shares([(0, goal)], starts, ends, None, time, None)[0]
+
+    assert share(750.0, 1400.0) == 0.0
+    assert share(750.0 * 1.09, 1400.0 * 0.94) == 0.0  # within both tolerances
+    assert share(750.0, 1400.0 * (1 + 0.07 * (1 + 0.5 * VOWEL_SPAN))) == pytest.approx(0.5)  # F2 half way on
+    assert share(615.0, 1729.0) == 1.0  # an /a/ heard /e/: the whole vowel
+    assert np.all((time[heard["frames"]] >= 0.025) & (time[heard["frames"]] <= 0.075))  # its middle half only
+    share(750.0, 1400.0)
+    heard["f"][time >= 0.08] = 5000.0  # off only after its middle half: not missed
+    assert heard_shares([(0, goal)], starts, ends, None, time, None)[0] == 0.0
+    heard["f"][:, :] = np.nan  # a closed tract: missed whole
+    assert heard_shares([(0, goal)], starts, ends, None, time, None)[0] == 1.0
 
 
 def test_the_segment_slowed_is_the_one_switched_on_last_before_the_fastest_movement():
