@@ -27,8 +27,9 @@ softens a step for the next.  A round faster than a speaker moves (peak speeds b
 counts as missing the share it is too fast of every constriction's interval; the next round is the same with
 its presses a step softer, or, no press being above 1, with the pulse of the segment whose forces switched on
 last before the fastest movement softer (the vowels' drives are kept: they are what reaches the vowels); when the
-round so slowed is too fast again, it is corrected as any other, its presses and that pulse softer as well.  Leads keep their bounds (:mod:`.leads`: a segment after a vowel
-switches on no earlier than the vowel's middle until it may press no harder).  The rounds stop when nothing
+round so slowed is too fast again, it is corrected as any other, its presses and that pulse softer as well.
+Leads keep their bounds (:mod:`.leads`: a segment after a vowel switches on no earlier than the vowel's middle
+until it may press no harder).  The rounds stop when nothing
 moves or every constriction is on time; of the rounds within the speed limits (any, when none is) the one that
 missed the fewest ms of its constrictions' intervals and of its vowels is the one kept (the corrections of a
 closure and of the channel after it can swing), with what it measured.  A vowel counts as missed by as much
@@ -109,7 +110,7 @@ def joined_goals(goals: list[Goal]) -> set[int]:
 
 def place_areas(u: Utterance, p: Plan, cfg: Config, model: Model, rest, goals: list[Goal], prior=None):
     """(the utterance's movement, {segment: its place's area per frame, cm^2}, (its course, the movement): the
-    ``prior`` of the next round, which simulates only from where its forces differ)."""
+    ``prior`` of the next round, which simulates only from where its forces differ, its tracts)."""
     c = force_course(u, p, model, cfg)
     traj = course_trajectory(model, c, cfg, rest, prior=prior, resumable=True)
     tracts = tracts_of_run(u, p, model, traj, cfg)
