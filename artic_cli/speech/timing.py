@@ -169,18 +169,23 @@ def heard_shares(vowels: list, starts: np.ndarray, ends: np.ndarray, tracts, tim
     """Per vowel (segment, its acoustic goal), the share of it a round missed: how far its F1 or F2 (medians of
     ``VOWEL_FRAMES`` frames over its middle half) stay beyond its tolerance, in ``VOWEL_SPAN`` tolerances, at most 1
     (a tract closed in most of them: 1)."""
-    out = {}
+    picked = {}
     for k, goal in vowels:
         a, b = starts[k] + 0.25 * (ends[k] - starts[k]), starts[k] + 0.75 * (ends[k] - starts[k])
         inside = np.flatnonzero((time_s >= a / 1e3) & (time_s <= b / 1e3))
-        if not len(inside):
-            continue
-        frames = inside[np.unique(np.linspace(0, len(inside) - 1, VOWEL_FRAMES).round().astype(int))]
-        f = formants_at(tracts, frames, cfg)[:, :2]
+        if len(inside):
+            picked[k] = inside[np.unique(np.linspace(0, len(inside) - 1, VOWEL_FRAMES).round().astype(int))]
+    if not picked:
+        return {}
+    heard = np.split(formants_at(tracts, np.concatenate(list(picked.values())), cfg)[:, :2],
+                     np.cumsum([len(f) for f in picked.values()])[:-1])  # every vowel's frames in one analysis
+    goals = dict(vowels)
+    out = {}
+    for (k, _), f in zip(picked.items(), heard):
         if np.mean(np.isfinite(f[:, 0])) < 0.5:
             out[k] = 1.0
             continue
-        off = np.abs(np.nanmedian(f, axis=0) / np.asarray(goal.formants_hz[:2], float) - 1.0) / goal.tolerance
+        off = np.abs(np.nanmedian(f, axis=0) / np.asarray(goals[k].formants_hz[:2], float) - 1.0) / goals[k].tolerance
         out[k] = float(np.clip((off.max() - 1.0) / VOWEL_SPAN, 0.0, 1.0))
     return out
 
