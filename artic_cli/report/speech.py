@@ -144,7 +144,7 @@ def vowel_class_table(records) -> tuple[list[str], list[Row]]:
     over its middle half) and the nearest of the five male Japanese means in Bark (speech/vowel_class.py, held to
     Praat in the tests); one row for how many sound as intended."""
     from ..speech.inventory import load_inventory
-    from ..speech.vowel_class import heard_vowels
+    from ..speech.vowel_class import heard_text, heard_vowels
 
     inv = load_inventory()
     means = {v: tuple(p.formants_hz[:2]) for v, p in inv.phonemes.items() if p.manner == "vowel"}
@@ -155,7 +155,7 @@ def vowel_class_table(records) -> tuple[list[str], list[Row]]:
     for path, rec, iv in spoken_phones(records, manners):
         found = heard_vowels(iv, rec.time_s, rec.formants_hz, means)
         ok, total = ok + sum(h["ok"] for h in found), total + len(found)
-        wrong = [f"/{h['label']}/ at {h['start_s']:.2f} s heard /{h['heard']}/ ({h['f1_hz']:.0f} / {h['f2_hz']:.0f} Hz)"
+        wrong = [f"/{h['label']}/ at {h['start_s']:.2f} s {heard_text(h)}"
                  for h in found if not h["ok"]]
         if wrong:
             out.append(f"* /{rec.attrs.get('name', path.stem)}/: " + "; ".join(wrong))

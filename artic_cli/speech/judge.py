@@ -8,7 +8,7 @@ import numpy as np
 
 from .inventory import Inventory
 from .landmarks import consonants, share_voiced, voiced_frames
-from .vowel_class import heard_vowels
+from .vowel_class import heard_text, heard_vowels
 
 DEVOICED = "\u0325"  # IPA's ring below: a devoiced vowel's label (u̥), no symbol of the inventory
 DEVOICED_VOICE_MAX = 0.5
@@ -42,7 +42,7 @@ def phone_results(x: np.ndarray, rate: int, iv: list[tuple[float, float, str]], 
         elif man == "vowel" and round(a, 6) in heard:
             h = heard[round(a, 6)]
             out.append({"label": lab, "start_s": a, "end_s": b, "kind": "vowel", "ok": h["ok"],
-                        "failed": [] if h["ok"] else [f"heard /{h['heard']}/ ({h['f1_hz']:.0f} / {h['f2_hz']:.0f} Hz)"]})
+                        "failed": [] if h["ok"] else [heard_text(h)]})
         elif man not in (None, "vowel") and round(a, 6) in measured:
             m = measured[round(a, 6)]
             failed = [k for k, ok in m["checks"].items() if not ok]

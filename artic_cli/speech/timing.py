@@ -164,6 +164,13 @@ def made_before(t: np.ndarray, area: np.ndarray, reach: float, start: float, flo
     return 1e3 * max(start - first, 0.0)
 
 
+def vowels_heard(segs, targets: list[TargetSpec | None]) -> list:
+    """(segment, its acoustic goal) of each vowel the timing hears by its formants: the voiced ones (a devoiced
+    vowel is judged by its voicelessness, not its sound)."""
+    return [(k, t.acoustic) for k, t in enumerate(targets) if t is not None and t.acoustic is not None
+            and segs[k].voiced]
+
+
 def heard_shares(vowels: list, starts: np.ndarray, ends: np.ndarray, tracts, time_s: np.ndarray, cfg: Config
                  ) -> dict[int, float]:
     """Per vowel (segment, its acoustic goal), the share of it a round missed: how far its F1 or F2 (medians of
@@ -210,7 +217,7 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
         return u, None
     segs = u.segments
     joined = joined_goals(goals)
-    heard = [(k, t.acoustic) for k, t in enumerate(targets) if t is not None and t.acoustic is not None]
+    heard = vowels_heard(segs, targets)
     kn = leads_of(u, targets, default_leads_ms(u, cfg)[0])
     starts, ends = kn.starts, kn.starts + np.array([s.duration_ms for s in segs])
     best = prior = None

@@ -24,10 +24,19 @@ def heard_vowels(intervals: list[tuple[float, float, str]], time_s: np.ndarray, 
             continue
         q = 0.25 * (t1 - t0)
         inside = (time_s >= t0 + q) & (time_s <= t1 - q)
-        f1, f2 = (float(np.nanmedian(formants_hz[inside, k])) if inside.any() else float("nan") for k in (0, 1))
+        f1, f2 = (float(np.nanmedian(formants_hz[inside, k])) if np.isfinite(formants_hz[inside, k]).any()
+                  else float("nan") for k in (0, 1))
         heard = nearest_vowel(f1, f2, means_hz) if np.isfinite(f1) and np.isfinite(f2) else ""
         out.append({"label": label, "start_s": t0, "f1_hz": f1, "f2_hz": f2, "heard": heard, "ok": heard == label})
     return out
 
 
-__all__ = ["heard_vowels", "nearest_vowel"]
+def heard_text(h: dict) -> str:
+    """What a vowel of :func:`heard_vowels` was heard as, in words: the vowel and its F1 / F2, or that it has
+    no formants (the tract closed through its middle half)."""
+    if not h["heard"]:
+        return "no formants: the tract closed through its middle half"
+    return f"heard /{h['heard']}/ ({h['f1_hz']:.0f} / {h['f2_hz']:.0f} Hz)"
+
+
+__all__ = ["heard_text", "heard_vowels", "nearest_vowel"]

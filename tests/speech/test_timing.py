@@ -125,3 +125,17 @@ def test_the_segment_slowed_is_the_one_switched_on_last_before_the_fastest_movem
     switches = np.array([-100.0, 80.0, 250.0, 320.0])
     assert fastest_switch({"tip": 1.2}, NS(time=t, x=x), model, switches) == 2  # switched on at 250 ms
     assert fastest_switch({"dorsum": 1.1, "tip": 1.05}, NS(time=t, x=x), model, switches) == 1
+
+
+def test_a_devoiced_vowel_is_not_heard_by_its_formants():
+    from artic_cli.control.solver import parse_target
+    from artic_cli.speech.timing import vowels_heard
+    from artic_cli.speech.utterance import Segment
+
+    vowel = parse_target({"name": "u", "jaw": {"forces_n": {"JO": 0.5}},
+                          "acoustic": {"formants_hz": [367.0, 1332.0]}})
+    stop = parse_target({"name": "k", "jaw": {"forces_n": {"JO": 0.5}},
+                         "constriction": {"place": "velum", "area_cm2": 0.0}})
+    segs = [Segment(target="k", duration_ms=75, voiced=False), Segment(target="u", duration_ms=80),
+            Segment(target="u", duration_ms=80, voiced=False)]
+    assert [k for k, _ in vowels_heard(segs, [stop, vowel, vowel])] == [1]

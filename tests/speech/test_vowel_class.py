@@ -26,3 +26,14 @@ def test_each_vowel_interval_is_judged_on_its_middle_half():
     assert heard[0]["f1_hz"] == 753.0
     wrong = heard_vowels([(0.0, 0.25, "u")], t, f, MEANS)
     assert wrong[0]["heard"] == "a" and not wrong[0]["ok"]
+
+
+def test_a_vowel_with_no_formants_says_its_tract_was_closed():
+    from artic_cli.speech.vowel_class import heard_text
+
+    t = np.arange(0.0, 0.2, 0.005)
+    f = np.full((len(t), 2), np.nan)
+    h = heard_vowels([(0.0, 0.2, "a")], t, f, MEANS)[0]
+    assert not h["ok"] and heard_text(h) == "no formants: the tract closed through its middle half"
+    f[:] = [600.0, 1700.0]
+    assert heard_text(heard_vowels([(0.0, 0.2, "a")], t, f, MEANS)[0]) == "heard /e/ (600 / 1700 Hz)"
