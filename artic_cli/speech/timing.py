@@ -32,10 +32,11 @@ Leads keep their bounds (:mod:`.leads`: a segment after a vowel switches on no e
 until it may press no harder).  The rounds stop when nothing
 moves or every constriction is on time; of the rounds within the speed limits (any, when none is) the one that
 missed the fewest ms of its constrictions' intervals and of its vowels is the one kept (the corrections of a
-closure and of the channel after it can swing), with what it measured.  A vowel counts as missed by as much
+closure and of the channel after it can swing), with what it measured.  A voiced vowel counts as missed by as much
 of its duration as its F1 or F2 (the tract's own, over its middle half) stay beyond its tolerance from its
 formant goal, a share growing to all of it ``VOWEL_SPAN`` tolerances further: a consonant that leads so far
-into a vowel that the vowel is not heard costs that vowel.
+into a vowel that the vowel is not heard costs that vowel.  A devoiced vowel is not heard (the judge asks only
+that it be voiceless).
 """
 
 from __future__ import annotations
