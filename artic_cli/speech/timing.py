@@ -21,7 +21,8 @@ place read frame by frame, and the leads and presses moved by what was measured:
   (a release on time: a stop's burst inside its interval, a voiced closure no longer than its voicing lasts).
 
 A vowel not heard near enough its formants (see below) opens with a harder pulse in the next round (its
-``drive``, :mod:`.leads`).  A round whose simulation is not physical (an inverted brick, a tongue off the tract's
+``drive``, :mod:`.leads`) and aims beyond its goal by a share of how far it was heard off (:mod:`.aims`; a round
+whose aims made it not physical is taken back, those vowels not aimed again).  A round whose simulation is not physical (an inverted brick, a tongue off the tract's
 grid) is never kept, its presses and drives become their ceilings less a step, and every press and drive above 1
 softens a step for the next.  A round faster than a speaker moves (peak speeds beyond the EMA range + 50 %)
 counts as missing the share it is too fast of every constriction's interval; the next round is the same with
@@ -41,7 +42,8 @@ that it be voiceless).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from typing import Callable
 
 import numpy as np
 
@@ -52,6 +54,7 @@ from ..mechanics.model import Model
 from ..mechanics.simulate import problems
 from ..tract.places import place_area, place_index, section_places
 from ..tract.speaker import speaker_tract
+from .aims import Aiming, aimed
 from .leads import LEAD_STEP_MS, Leads, leads_of
 from .measures import peak_speeds, too_fast
 from .plan import Plan
@@ -87,6 +90,8 @@ class Timing:
     held_late_ms: dict[int, float]  # ... how long after its end it still held
     trajectory: object = None  # the returned utterance's movement, when the last round simulated it as it is
     drive: list[float] | None = None  # each segment's pulse factor (None: 1 each)
+    plan: Plan | None = None  # the plan the kept round spoke: its vowels' forces aimed in context (:mod:`.aims`)
+    aims_hz: dict[int, list[float]] | None = None  # per vowel aimed beyond its goal: the F1 and F2 it aimed at
 
 
 def goals_of(targets: list[TargetSpec | None], cfg: Config) -> list[Goal]:
@@ -172,11 +177,10 @@ def vowels_heard(segs, targets: list[TargetSpec | None]) -> list:
             and segs[k].voiced]
 
 
-def heard_shares(vowels: list, starts: np.ndarray, ends: np.ndarray, tracts, time_s: np.ndarray, cfg: Config
-                 ) -> dict[int, float]:
-    """Per vowel (segment, its acoustic goal), the share of it a round missed: how far its F1 or F2 (medians of
-    ``VOWEL_FRAMES`` frames over its middle half) stay beyond its tolerance, in ``VOWEL_SPAN`` tolerances, at most 1
-    (a tract closed in most of them: 1)."""
+def heard_formants(vowels: list, starts: np.ndarray, ends: np.ndarray, tracts, time_s: np.ndarray, cfg: Config
+                   ) -> dict[int, np.ndarray]:
+    """Per vowel (segment, its acoustic goal), its F1 and F2 (Hz) as a round heard them: medians of
+    ``VOWEL_FRAMES`` frames over its middle half (NaN: a tract closed in most of them)."""
     picked = {}
     for k, goal in vowels:
         a, b = starts[k] + 0.25 * (ends[k] - starts[k]), starts[k] + 0.75 * (ends[k] - starts[k])
@@ -187,15 +191,29 @@ def heard_shares(vowels: list, starts: np.ndarray, ends: np.ndarray, tracts, tim
         return {}
     heard = np.split(formants_at(tracts, np.concatenate(list(picked.values())), cfg)[:, :2],
                      np.cumsum([len(f) for f in picked.values()])[:-1])  # every vowel's frames in one analysis
+    return {k: (np.nanmedian(f, axis=0) if np.mean(np.isfinite(f[:, 0])) >= 0.5 else np.full(2, np.nan))
+            for k, f in zip(picked, heard)}
+
+
+def shares_missed(vowels: list, heard: dict[int, np.ndarray]) -> dict[int, float]:
+    """Per vowel heard (:func:`heard_formants`), the share of it missed: how far its F1 or F2 stay beyond its
+    tolerance, in ``VOWEL_SPAN`` tolerances, at most 1 (no formants: 1)."""
     goals = dict(vowels)
     out = {}
-    for (k, _), f in zip(picked.items(), heard):
-        if np.mean(np.isfinite(f[:, 0])) < 0.5:
+    for k, f in heard.items():
+        if not np.all(np.isfinite(f)):
             out[k] = 1.0
             continue
-        off = np.abs(np.nanmedian(f, axis=0) / np.asarray(goals[k].formants_hz[:2], float) - 1.0) / goals[k].tolerance
+        off = np.abs(f / np.asarray(goals[k].formants_hz[:2], float) - 1.0) / goals[k].tolerance
         out[k] = float(np.clip((off.max() - 1.0) / VOWEL_SPAN, 0.0, 1.0))
     return out
+
+
+def heard_shares(vowels: list, starts: np.ndarray, ends: np.ndarray, tracts, time_s: np.ndarray, cfg: Config
+                 ) -> dict[int, float]:
+    """Per vowel (segment, its acoustic goal), the share of it a round missed (:func:`heard_formants`,
+    :func:`shares_missed`)."""
+    return shares_missed(vowels, heard_formants(vowels, starts, ends, tracts, time_s, cfg))
 
 
 def fastest_switch(fast: dict[str, float], traj, model: Model, switches_ms: np.ndarray) -> int:
@@ -209,10 +227,49 @@ def fastest_switch(fast: dict[str, float], traj, model: Model, switches_ms: np.n
     return max(int(np.searchsorted(switches_ms, peak_ms, side="right")) - 1, 0)
 
 
+Aim = Callable[[TargetSpec], tuple[dict[str, float], str, str]]  # a target -> its forces, how found, its file
+
+
+def moved_aims(aims: dict[int, np.ndarray], before: dict[int, np.ndarray]) -> list[int]:
+    """The vowels whose aim differs from the one ``before`` (or that had one before and none now)."""
+    return sorted(k for k in set(aims) | set(before) if k not in aims or k not in before
+                  or not np.array_equal(aims[k], before[k]))
+
+
+def aimed_back(physical: tuple[Plan, Aiming] | None, aiming: Aiming) -> tuple[Plan, Aiming] | None:
+    """After a round that was not physical, when vowels were aimed anew since the last ``physical`` round (its
+    plan and aims): that round's plan and aims, those vowels not aimed again; else None."""
+    moved = [] if physical is None else moved_aims(aiming.aims, physical[1].aims)
+    if not moved:
+        return None
+    back = physical[1].copy()
+    back.frozen.update(moved)
+    return physical[0], back
+
+
+def aim_vowel(p: Plan, given: Plan, k: int, t: TargetSpec, heard_hz: np.ndarray, aiming: Aiming, aim: Aim
+              ) -> tuple[Plan, bool]:
+    """Vowel ``k``, missed as heard at ``heard_hz``, aimed anew (:meth:`Aiming.step`): (the plan with its forces,
+    those of its aim or, at its own goal, its ``given`` ones; whether they moved)."""
+    moved, now = aiming.step(k, t.acoustic.formants_hz[:2], heard_hz)
+    if not moved:
+        return p, False
+    found = (given.forces_n[k], given.notes[k], given.solutions[k]) if now is None else aim(aimed(t, now))
+    return with_forces(p, k, found), True
+
+
+def with_forces(p: Plan, k: int, found: tuple[dict[str, float], str, str]) -> Plan:
+    """The plan with segment ``k``'s forces, note and solution file those ``found``."""
+    forces, notes, files = list(p.forces_n), list(p.notes), list(p.solutions)
+    forces[k], notes[k], files[k] = dict(found[0]), found[1], str(found[2])
+    return replace(p, forces_n=forces, notes=notes, solutions=files)
+
+
 def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[TargetSpec | None],
-          rounds: int = ROUNDS) -> tuple[Utterance, Timing | None]:
+          rounds: int = ROUNDS, aim: Aim | None = None) -> tuple[Utterance, Timing | None]:
     """The utterance with the leads and presses its constrictions need (see the module's text); unchanged, with
-    no timing, when it asks for no constriction."""
+    no timing, when it asks for no constriction.  ``aim``: solves a vowel's target aimed elsewhere (:mod:`.aims`;
+    None: vowels are not aimed)."""
     goals = goals_of(targets, cfg)
     if not goals:
         return u, None
@@ -223,6 +280,8 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
     starts, ends = kn.starts, kn.starts + np.array([s.duration_ms for s in segs])
     best = prior = None
     slowing = False  # the round before was slowed alone
+    aiming, given = Aiming(), p  # the vowels' aims in context; the plan as it came
+    physical = None  # the plan and aims of the last round that was physical
     for r in range(rounds):
         trial = with_leads(u, kn.leads, kn.press, kn.drive)
         try:
@@ -230,29 +289,25 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
             bad = bool(problems(traj, model.volume_constraint))
         except OffGrid:  # the tongue left the tract's grid
             bad = True
-        if bad:  # pressed too hard: never kept, every press softer
-            if not kn.too_hard():
+        if bad:  # aimed too far: the aims of the last physical round, not aimed again; else pressed too hard
+            if (back := aimed_back(physical, aiming)) is not None:
+                p, aiming = back
+                continue
+            if not kn.too_hard():  # every press softer
                 break
             continue
         t = traj.time
         tried = kn.leads.copy(), kn.press.copy(), kn.drive.copy()
-        late, early, held, soon = {}, {}, {}, {}
+        physical = p, aiming.copy()
+        late, early, held, soon = measure(goals, joined, t, areas, starts, ends)
         changed = False
         for g in goals:
             k = g.segment
-            area = areas[k]
-            late[k], early[k] = onset_and_release(t, area, g.reach_cm2, starts[k] / 1e3, ends[k] / 1e3, g.floor_cm2)
-            # made early only while there is sound (an utterance-initial closure may shut before it starts), and
-            # not at all the second of one constriction over two segments (Q and its consonant) ...
-            soon[k] = 0.0 if k - 1 in joined else min(
-                made_before(t, area, g.reach_cm2, starts[k] / 1e3, g.floor_cm2), float(starts[k]))
-            # ... whose first is held into it by design
-            held[k] = held_after(t, area, g.reach_cm2, ends[k] / 1e3, g.floor_cm2) if (
-                np.isfinite(late[k]) and k not in joined) else 0.0
-            changed |= correct(kn, g, segs, t, area, (late[k], early[k], soon[k], held[k]), ends[k])
+            changed |= correct(kn, g, segs, t, areas[k], (late[k], early[k], soon[k], held[k]), ends[k])
         kn.in_order()
         score = missed_ms(goals, late, early, starts, ends, areas, t)
-        shares = heard_shares(heard, starts, ends, tracts, traj.time, cfg)
+        heard_hz = heard_formants(heard, starts, ends, tracts, traj.time, cfg)
+        shares = shares_missed(heard, heard_hz)
         score += sum((ends[k] - starts[k]) * v for k, v in shares.items())
         score += sum(max(h - HELD_MS, 0.0) for h in held.values()) + sum(max(a - EARLY_MS, 0.0) for a in soon.values())
         fast = too_fast(peak_speeds(t, {n: traj.x[:, i] for n, i in model.control_points().items()}))
@@ -272,19 +327,43 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
         else:  # a vowel not reached: its pulse harder
             for k, v in shares.items():
                 changed |= v > 0 and kn.drive_more(k)
+                if v > 0 and aim is not None:
+                    p, moved = aim_vowel(p, given, k, targets[k], heard_hz[k], aiming, aim)
+                    changed |= moved
         key = (bool(fast), score)  # a round within the speed limits before any beyond them
         if best is None or key < best[0]:
-            best = (key, r, tried, late, early, held, traj)
-        changed &= not all(np.array_equal(a, b) for a, b in zip((kn.leads, kn.press, kn.drive), tried))  # all bound
+            best = (key, r, tried, late, early, held, traj, *physical)
+        changed &= bool(moved_aims(aiming.aims, physical[1].aims)) or not all(  # all bound
+            np.array_equal(a, b) for a, b in zip((kn.leads, kn.press, kn.drive), tried))
         slowing = slowed
         if not changed or score == 0.0:
             break
     if best is None:  # no round was physical: the last, for the caller to refuse
         return with_leads(u, kn.leads, kn.press, kn.drive), None
-    _, _, (leads, press, drive), late, early, held, traj = best
-    return with_leads(u, leads, press, drive), Timing(leads_ms=leads.tolist(), press=press.tolist(), rounds=r + 1,
-                                                      onset_late_ms=late, released_early_ms=early,
-                                                      held_late_ms=held, trajectory=traj, drive=drive.tolist())
+    _, _, (leads, press, drive), late, early, held, traj, kept, kept_aims = best
+    return with_leads(u, leads, press, drive), Timing(
+        leads_ms=leads.tolist(), press=press.tolist(), rounds=r + 1, onset_late_ms=late, released_early_ms=early,
+        held_late_ms=held, trajectory=traj, drive=drive.tolist(), plan=kept,
+        aims_hz={k: [float(v) for v in a] for k, a in kept_aims.aims.items()})
+
+
+def measure(goals: list[Goal], joined: set[int], t: np.ndarray, areas: dict, starts: np.ndarray, ends: np.ndarray
+            ) -> tuple[dict, dict, dict, dict]:
+    """Per constriction segment, what a round made of it (ms): how late it was made, how early released, how
+    long held past its end, how long made before its start."""
+    late, early, held, soon = {}, {}, {}, {}
+    for g in goals:
+        k = g.segment
+        area = areas[k]
+        late[k], early[k] = onset_and_release(t, area, g.reach_cm2, starts[k] / 1e3, ends[k] / 1e3, g.floor_cm2)
+        # made early only while there is sound (an utterance-initial closure may shut before it starts), and
+        # not at all the second of one constriction over two segments (Q and its consonant) ...
+        soon[k] = 0.0 if k - 1 in joined else min(
+            made_before(t, area, g.reach_cm2, starts[k] / 1e3, g.floor_cm2), float(starts[k]))
+        # ... whose first is held into it by design
+        held[k] = held_after(t, area, g.reach_cm2, ends[k] / 1e3, g.floor_cm2) if (
+            np.isfinite(late[k]) and k not in joined) else 0.0
+    return late, early, held, soon
 
 
 def correct(kn: Leads, g: Goal, segs, t: np.ndarray, area: np.ndarray, measured: tuple, end_ms: float) -> bool:

@@ -9,7 +9,8 @@ written last.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import json
+from dataclasses import dataclass, replace
 from functools import partial
 from pathlib import Path
 from typing import Callable
@@ -25,7 +26,7 @@ from ..io.store import atomic_h5, open_artifact, stored_content_hash
 from ..io.wav import write_wav
 from ..mechanics.model import ARTICULATOR_SECTIONS, Model, State
 from ..mechanics.simulate import settle
-from ..speech.plan import Plan, needs_dynamic, plan, segment_targets
+from ..speech.plan import Plan, needs_dynamic, plan, segment_targets, settle_answers
 from ..speech.record import Record
 from ..speech.speak import Spoken, speak_plan
 from ..speech.textgrid import write_textgrid
@@ -254,12 +255,16 @@ def speak(utterance: Path | str | Utterance, out: Path | str | None = None, maps
     view = STAGE.view(cfg)
     p = plan(u, view, targets, solve, accept_nearest, say)
     rest = rest_posture(model, caches["rest"])
-    u, timing = timed_once(u, p, view, model, rest, targets, caches["timing"])
+    aim = partial(aim_answer, partial(solve, budget=AIM_BUDGET))
+    u, timing = timed_once(u, p, view, model, rest, targets, caches["timing"], aim)
+    if timing is not None and timing.plan is not None:
+        p = timing.plan
     if timing is not None and say:
         how = f"{timing.rounds} round(s)" if timing.rounds else "as found before"
         say(f"timing: {how}; leads {', '.join(f'{v:.0f}' for v in timing.leads_ms)} ms; "
             f"presses {', '.join(f'{v:.2f}' for v in timing.press)}; "
-            f"drives {', '.join(f'{v:.2f}' for v in timing.drive)}")
+            f"drives {', '.join(f'{v:.2f}' for v in timing.drive)}"
+            + "".join(f"; segment {k} aimed at {a[0]:.0f} / {a[1]:.0f} Hz" for k, a in (timing.aims_hz or {}).items()))
     s = speak_plan(u, p, view, model, progress, rest, timing.trajectory if timing is not None else None,
                    caches["ep"])
     written = write(out, s, prov)
@@ -277,11 +282,22 @@ def articulator(cfg: Config, m, cache: ResultCache):
     return model
 
 
-def timed_once(u: Utterance, p: Plan, cfg: Config, model, rest, targets, cache: ResultCache):
-    """:func:`timed`, its leads and presses kept in ``cache`` by what they hang on (the utterance but its name
-    and pitch, the plan, the config, the timing's code), so that the same utterance at another pitch or under
-    another name is not timed again: (the utterance with its leads and presses, its timing; rounds 0 when
-    found before)."""
+AIM_BUDGET = 0  # simulations refining a vowel aimed in context: none, the rounds hear where it lands
+
+
+def aim_answer(solve, t) -> tuple[dict[str, float], str, str]:
+    """A vowel's target aimed in context (:mod:`artic_cli.speech.aims`) solved: (its forces, how they were found,
+    its solution file); its nearest answer when out of reach."""
+    forces, note, path = settle_answers([(0, t)], solve, True)[0]
+    a = t.acoustic.formants_hz
+    return forces, f"aimed at {a[0]:.0f} / {a[1]:.0f} Hz in context ({note})", str(path)
+
+
+def timed_once(u: Utterance, p: Plan, cfg: Config, model, rest, targets, cache: ResultCache, aim=None):
+    """:func:`timed`, its leads, presses, drives and aimed vowels kept in ``cache`` by what they hang on (the
+    utterance but its name and pitch, the plan, the config, the timing's code), so that the same utterance at
+    another pitch or under another name is not timed again: (the utterance with its leads and presses, its
+    timing, whose plan holds the forces its vowels aimed with; rounds 0 when found before)."""
     key = {"utterance": u.model_dump(mode="json", exclude={"name", "f0_hz"}), "forces": p.forces_n,
            "lips": p.lips, "ports": p.ports, "glottis": p.glottis_cm2, "voiced": p.voiced, "starts": p.starts_s,
            "durations": p.durations_s, "config": sections_hash(cfg, STAGE.sections),
@@ -290,13 +306,18 @@ def timed_once(u: Utterance, p: Plan, cfg: Config, model, rest, targets, cache: 
     n = (len(u.segments),)
     if hit is not None and hit.get("leads_ms", np.zeros(0)).shape == n == hit["press"].shape == hit.get(
             "drive", np.zeros(0)).shape:
+        kept = json.loads(str(hit["plan"])) if "plan" in hit else {}
         return with_leads(u, hit["leads_ms"], hit["press"], hit["drive"]), Timing(
             leads_ms=hit["leads_ms"].tolist(), press=hit["press"].tolist(), rounds=0, onset_late_ms={},
-            released_early_ms={}, held_late_ms={}, drive=hit["drive"].tolist())
-    out, timing = timed(u, p, cfg, model, rest, targets)
+            released_early_ms={}, held_late_ms={}, drive=hit["drive"].tolist(),
+            plan=replace(p, **{k: kept[k] for k in ("forces_n", "notes", "solutions")}) if kept else None,
+            aims_hz={int(k): v for k, v in kept.get("aims_hz", {}).items()})
+    out, timing = timed(u, p, cfg, model, rest, targets, aim=aim)
     if timing is not None:
+        kept = {} if timing.plan is None else {"forces_n": timing.plan.forces_n, "notes": timing.plan.notes,
+                                               "solutions": timing.plan.solutions, "aims_hz": timing.aims_hz}
         cache.put(key, {"leads_ms": np.asarray(timing.leads_ms, float), "press": np.asarray(timing.press, float),
-                        "drive": np.asarray(timing.drive, float)})
+                        "drive": np.asarray(timing.drive, float), "plan": np.array(json.dumps(kept))})
     return out, timing
 
 

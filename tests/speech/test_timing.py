@@ -139,3 +139,31 @@ def test_a_devoiced_vowel_is_not_heard_by_its_formants():
     segs = [Segment(target="k", duration_ms=75, voiced=False), Segment(target="u", duration_ms=80),
             Segment(target="u", duration_ms=80, voiced=False)]
     assert [k for k, _ in vowels_heard(segs, [stop, vowel, vowel])] == [1]
+
+
+def test_a_vowel_missed_speaks_the_forces_of_its_aim_and_its_own_again_when_the_aim_closes_its_tract():
+    from artic_cli.control.solver import parse_target
+    from artic_cli.speech.aims import Aiming
+    from artic_cli.speech.plan import Plan
+    from artic_cli.speech.timing import aim_vowel
+
+    t = parse_target({"name": "a_vowel", "jaw": {"forces_n": {"JO": 6.0}},
+                      "acoustic": {"formants_hz": [750, 1400], "tolerance_pct": [10, 7]}}, "test", 15.0)
+    given = Plan(labels=["k", "a"], starts_s=np.array([0.0, 0.075]), durations_s=np.array([0.075, 0.075]),
+                 forces_n=[{"GGp": 3.0}, {"JO": 6.0, "GGp": 0.5}], lips=[(2.0, 1.0)] * 2, ports=[0.0, 0.0],
+                 voiced=np.array([False, True]), glottis_cm2=np.array([0.3, 0.05]), notes=["solved"] * 2,
+                 solutions=["k.yaml", "a.yaml"])
+    asked = []
+
+    def aim(target):
+        asked.append(target)
+        return {"JO": 6.0, "HG": 1.0}, "aimed", "aim.yaml"
+
+    aiming = Aiming()
+    p, moved = aim_vowel(given, given, 1, t, np.array([600.0, 1700.0]), aiming, aim)
+    assert moved and p.forces_n[1] == {"JO": 6.0, "HG": 1.0} and p.solutions[1] == "aim.yaml"
+    assert p.forces_n[0] == given.forces_n[0] and given.forces_n[1] == {"JO": 6.0, "GGp": 0.5}
+    f1, f2 = asked[0].acoustic.formants_hz[:2]
+    assert f1 > 750 and f2 < 1400  # aimed beyond /a/, away from where it was heard
+    back, moved = aim_vowel(p, given, 1, t, np.array([np.nan, np.nan]), aiming, aim)
+    assert moved and back.forces_n[1] == given.forces_n[1] and back.notes[1] == "solved" and len(asked) == 1

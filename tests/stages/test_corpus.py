@@ -294,6 +294,7 @@ def test_a_word_at_another_pitch_is_not_timed_again_and_moves_the_same(corpus_se
         assert np.array_equal(low.control_points[name], high.control_points[name])
     assert list(low.leads_ms) == list(high.leads_ms) and list(low.press) == list(high.press)
     assert len(low.drive) == len(low.press) and list(low.drive) == list(high.drive)  # the drives kept too
+    assert np.array_equal(low.commanded_n, high.commanded_n)  # and the forces, its vowels' aims among them
     y, rate = read_wav(tmp / "pitch" / "low.wav")
     times = np.linspace(0.03, len(y) / rate - 0.03, 25)
     f0 = {n: float(np.nanmedian(praat_f0(tmp / "pitch" / f"{n}.wav", times))) for n in ("low", "high")}

@@ -1,0 +1,89 @@
+"""A vowel aimed beyond its formants in context: the compensation of undershoot (Lindblom 1963) learnt from the
+model's own movement.
+
+A short vowel between consonants is not reached in its 60-90 ms, and its formants stay on the consonants' side.
+When the timing's rounds (:mod:`.timing`) hear a vowel beyond its tolerance, the next round aims it beyond its
+goal by ``AIM_GAIN`` of how far it was heard off, on the Bark scale (F1 and F2 each: aim' = aim + ``AIM_GAIN``
+(goal - heard)), within ``AIM_SPAN_BARK`` of the goal.  The aim's forces are solved on the maps as the vowel's
+own are, its jaw, lips, port and where its tongue is highest kept.  A vowel heard further off with its new aim
+than with the one before (a tract it closes is infinitely far) goes back to the aim before and is not aimed
+again.  The vowel's target, and so an isolated vowel, is unchanged: only its forces in this utterance aim
+elsewhere.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..control.solver import TargetSpec
+from ..units import bark_to_hz, hz_to_bark
+
+AIM_SPAN_BARK = 1.5  # an aim at most this far from its vowel's goal, F1 and F2 each
+AIM_GAIN = 0.5  # an aim moves this share of how far its vowel was heard from its goal
+
+
+def next_aim(aim_hz, goal_hz, heard_hz, gain: float = AIM_GAIN) -> np.ndarray | None:
+    """(2,) Hz: the aim moved by ``gain`` times how far the vowel was heard from its goal (Bark), within
+    ``AIM_SPAN_BARK`` of the goal; None when the vowel had no formants (a closed tract says nothing of where to aim)."""
+    heard = np.asarray(heard_hz, float)[:2]
+    if not np.all(np.isfinite(heard)):
+        return None
+    goal = hz_to_bark(np.asarray(goal_hz, float)[:2])
+    moved = hz_to_bark(np.asarray(aim_hz, float)[:2]) + gain * (goal - hz_to_bark(heard))
+    return np.round(bark_to_hz(np.clip(moved, goal - AIM_SPAN_BARK, goal + AIM_SPAN_BARK)), 0)
+
+
+def distance_bark(goal_hz, heard_hz) -> float:
+    """How far a vowel was heard from its goal (Bark, F1-F2 plane; a closed tract: infinitely far)."""
+    d = float(np.linalg.norm(hz_to_bark(np.asarray(heard_hz, float)[:2]) - hz_to_bark(np.asarray(goal_hz, float)[:2])))
+    return d if np.isfinite(d) else float("inf")
+
+
+@dataclass
+class Aiming:
+    """The vowels of one utterance aimed in context, round by round: each one's aim (Hz), the aim before it
+    (None: its own goal) and how far the vowel was heard from its goal with that one; a vowel heard further
+    off with its aim than before goes back to the aim before and is not aimed again."""
+
+    aims: dict[int, np.ndarray] = field(default_factory=dict)
+    before: dict[int, np.ndarray | None] = field(default_factory=dict)
+    heard_off: dict[int, float] = field(default_factory=dict)
+    frozen: set[int] = field(default_factory=set)
+
+    def step(self, k: int, goal_hz, heard_hz) -> tuple[bool, np.ndarray | None]:
+        """Vowel ``k`` missed, heard at ``heard_hz``: (whether its aim moved, its aim now: None for its goal)."""
+        d = distance_bark(goal_hz, heard_hz)
+        if k in self.before and d > self.heard_off.get(k, float("inf")):  # worse than before: back, and no more
+            self.frozen.add(k)
+            back = self.before.pop(k)
+            del self.aims[k]
+            if back is not None:
+                self.aims[k] = back
+            return True, back
+        self.heard_off[k] = d
+        if k in self.frozen:
+            return False, self.aims.get(k)
+        new = next_aim(self.aims.get(k, goal_hz), goal_hz, heard_hz)
+        if new is None or (k in self.aims and np.array_equal(new, self.aims[k])):
+            return False, self.aims.get(k)
+        self.before[k] = self.aims.get(k)
+        self.aims[k] = new
+        return True, new
+
+    def copy(self) -> "Aiming":
+        return Aiming(dict(self.aims), dict(self.before), dict(self.heard_off), set(self.frozen))
+
+
+def aimed(t: TargetSpec, aim_hz) -> TargetSpec:
+    """The vowel's target with its F1 and F2 at ``aim_hz`` (its F3, tolerance, jaw, lips, port and tongue class
+    kept), named by its aim."""
+    f = [float(v) for v in np.asarray(aim_hz, float)[:2]] + list(t.acoustic.formants_hz[2:])
+    if f[1] <= f[0]:  # a goal's formants rise
+        f[1] = f[0] + 1.0
+    acoustic = t.acoustic.model_copy(update={"formants_hz": f})
+    return t.model_copy(update={"acoustic": acoustic, "name": f"{t.name}-aim-{f[0]:.0f}-{f[1]:.0f}"})
+
+
+__all__ = ["AIM_GAIN", "AIM_SPAN_BARK", "Aiming", "aimed", "distance_bark", "next_aim"]
