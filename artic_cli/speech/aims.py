@@ -52,25 +52,30 @@ class Aiming:
     heard_off: dict[int, float] = field(default_factory=dict)
     frozen: set[int] = field(default_factory=set)
 
-    def step(self, k: int, goal_hz, heard_hz) -> tuple[bool, np.ndarray | None]:
-        """Vowel ``k`` missed, heard at ``heard_hz``: (whether its aim moved, its aim now: None for its goal)."""
+    def step(self, k: int, goal_hz, heard_hz) -> tuple[bool, np.ndarray | None, bool]:
+        """Vowel ``k`` missed, heard at ``heard_hz``: (whether its aim moved, its aim now: None for its goal,
+        whether it went back)."""
         d = distance_bark(goal_hz, heard_hz)
         if k in self.before and d > self.heard_off.get(k, float("inf")):  # worse than before: back, and no more
-            self.frozen.add(k)
-            back = self.before.pop(k)
-            del self.aims[k]
-            if back is not None:
-                self.aims[k] = back
-            return True, back
+            return True, self.refuse(k), True
         self.heard_off[k] = d
         if k in self.frozen:
-            return False, self.aims.get(k)
+            return False, self.aims.get(k), False
         new = next_aim(self.aims.get(k, goal_hz), goal_hz, heard_hz)
         if new is None or (k in self.aims and np.array_equal(new, self.aims[k])):
-            return False, self.aims.get(k)
+            return False, self.aims.get(k), False
         self.before[k] = self.aims.get(k)
         self.aims[k] = new
-        return True, new
+        return True, new, False
+
+    def refuse(self, k: int) -> np.ndarray | None:
+        """Vowel ``k``'s last aim taken back, and not aimed again: the aim before it (None: its goal)."""
+        self.frozen.add(k)
+        back = self.before.pop(k, None)
+        self.aims.pop(k, None)
+        if back is not None:
+            self.aims[k] = back
+        return back
 
     def copy(self) -> "Aiming":
         return Aiming(dict(self.aims), dict(self.before), dict(self.heard_off), set(self.frozen))

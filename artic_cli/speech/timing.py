@@ -21,8 +21,9 @@ place read frame by frame, and the leads and presses moved by what was measured:
   (a release on time: a stop's burst inside its interval, a voiced closure no longer than its voicing lasts).
 
 A vowel not heard near enough its formants (see below) opens with a harder pulse in the next round (its
-``drive``, :mod:`.leads`) and aims beyond its goal by a share of how far it was heard off (:mod:`.aims`; a round
-whose aims made it not physical is taken back, those vowels not aimed again).  A round whose simulation is not physical (an inverted brick, a tongue off the tract's
+``drive``, :mod:`.leads`) and aims beyond its goal by a share of how far it was heard off (:mod:`.aims`); an aim
+that took it further off is taken back (its pulse not harder for that round), and so are the aims of a round they
+made not physical, those vowels not aimed again.  A round whose simulation is not physical (an inverted brick, a tongue off the tract's
 grid) is never kept, its presses and drives become their ceilings less a step, and every press and drive above 1
 softens a step for the next.  A round faster than a speaker moves (peak speeds beyond the EMA range + 50 %)
 counts as missing the share it is too fast of every constriction's interval; the next round is the same with
@@ -236,6 +237,21 @@ def moved_aims(aims: dict[int, np.ndarray], before: dict[int, np.ndarray]) -> li
                   or not np.array_equal(aims[k], before[k]))
 
 
+def vowels_missed(p: Plan, given: Plan, shares: dict, heard_hz: dict, targets: list, aiming: Aiming,
+                  aim: Aim | None, kn: Leads) -> tuple[Plan, bool]:
+    """Each vowel a round missed aimed further (:func:`aim_vowel`, when ``aim`` is given) and its pulse harder,
+    unless its aim was what missed it (taken back): (the plan, whether anything moved)."""
+    changed = False
+    for k in (k for k, v in shares.items() if v > 0):
+        back = False
+        if aim is not None:
+            p, moved, back = aim_vowel(p, given, k, targets[k], heard_hz[k], aiming, aim)
+            changed |= moved
+        if not back:
+            changed |= kn.drive_more(k)
+    return p, changed
+
+
 def aimed_back(physical: tuple[Plan, Aiming] | None, aiming: Aiming) -> tuple[Plan, Aiming] | None:
     """After a round that was not physical, when vowels were aimed anew since the last ``physical`` round (its
     plan and aims): that round's plan and aims, those vowels not aimed again; else None."""
@@ -248,14 +264,16 @@ def aimed_back(physical: tuple[Plan, Aiming] | None, aiming: Aiming) -> tuple[Pl
 
 
 def aim_vowel(p: Plan, given: Plan, k: int, t: TargetSpec, heard_hz: np.ndarray, aiming: Aiming, aim: Aim
-              ) -> tuple[Plan, bool]:
+              ) -> tuple[Plan, bool, bool]:
     """Vowel ``k``, missed as heard at ``heard_hz``, aimed anew (:meth:`Aiming.step`): (the plan with its forces,
-    those of its aim or, at its own goal, its ``given`` ones; whether they moved)."""
-    moved, now = aiming.step(k, t.acoustic.formants_hz[:2], heard_hz)
+    those of its aim or, at its own goal, its ``given`` ones; whether they moved; whether the vowel went back to
+    an aim before).  The aim's forces are the maps' answer, whatever their static formants: the rounds hear where
+    they take the vowel in context."""
+    moved, now, back = aiming.step(k, t.acoustic.formants_hz[:2], heard_hz)
     if not moved:
-        return p, False
+        return p, False, back
     found = (given.forces_n[k], given.notes[k], given.solutions[k]) if now is None else aim(aimed(t, now))
-    return with_forces(p, k, found), True
+    return with_forces(p, k, found), True, back
 
 
 def with_forces(p: Plan, k: int, found: tuple[dict[str, float], str, str]) -> Plan:
@@ -324,12 +342,9 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
             else:  # ... then, when that did not do, corrected as any round, and softer
                 kn.leads, kn.press, kn.drive = corrected
                 changed |= kn.too_hard(drives=False) | kn.drive_less(culprit)
-        else:  # a vowel not reached: its pulse harder
-            for k, v in shares.items():
-                changed |= v > 0 and kn.drive_more(k)
-                if v > 0 and aim is not None:
-                    p, moved = aim_vowel(p, given, k, targets[k], heard_hz[k], aiming, aim)
-                    changed |= moved
+        else:  # a vowel not reached: aimed further and its pulse harder
+            p, reaimed = vowels_missed(p, given, shares, heard_hz, targets, aiming, aim, kn)
+            changed |= reaimed
         key = (bool(fast), score)  # a round within the speed limits before any beyond them
         if best is None or key < best[0]:
             best = (key, r, tried, late, early, held, traj, *physical)

@@ -286,11 +286,12 @@ AIM_BUDGET = 0  # simulations refining a vowel aimed in context: none, the round
 
 
 def aim_answer(solve, t) -> tuple[dict[str, float], str, str]:
-    """A vowel's target aimed in context (:mod:`artic_cli.speech.aims`) solved: (its forces, how they were found,
-    its solution file); its nearest answer when out of reach."""
+    """A vowel's target aimed in context (:mod:`artic_cli.speech.aims`) solved on the maps: (its forces, how they
+    were found, its solution file); its nearest answer when out of reach."""
     forces, note, path = settle_answers([(0, t)], solve, True)[0]
     a = t.acoustic.formants_hz
-    return forces, f"aimed at {a[0]:.0f} / {a[1]:.0f} Hz in context ({note})", str(path)
+    how = "the nearest answer" if note.startswith("unreachable") else "on the maps"
+    return forces, f"aimed at {a[0]:.0f} / {a[1]:.0f} Hz in context ({how})", str(path)
 
 
 def timed_once(u: Utterance, p: Plan, cfg: Config, model, rest, targets, cache: ResultCache, aim=None):
@@ -307,10 +308,11 @@ def timed_once(u: Utterance, p: Plan, cfg: Config, model, rest, targets, cache: 
     if hit is not None and hit.get("leads_ms", np.zeros(0)).shape == n == hit["press"].shape == hit.get(
             "drive", np.zeros(0)).shape:
         kept = json.loads(str(hit["plan"])) if "plan" in hit else {}
+        aimed_plan = replace(p, **{k: kept[k] for k in ("forces_n", "notes", "solutions")}) if kept else None
         return with_leads(u, hit["leads_ms"], hit["press"], hit["drive"]), Timing(
             leads_ms=hit["leads_ms"].tolist(), press=hit["press"].tolist(), rounds=0, onset_late_ms={},
             released_early_ms={}, held_late_ms={}, drive=hit["drive"].tolist(),
-            plan=replace(p, **{k: kept[k] for k in ("forces_n", "notes", "solutions")}) if kept else None,
+            plan=aimed_plan,
             aims_hz={int(k): v for k, v in kept.get("aims_hz", {}).items()})
     out, timing = timed(u, p, cfg, model, rest, targets, aim=aim)
     if timing is not None:

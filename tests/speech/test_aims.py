@@ -45,15 +45,19 @@ def test_a_vowel_heard_further_off_with_its_aim_goes_back_to_the_aim_before_and_
     from artic_cli.speech.aims import Aiming
 
     a = Aiming()
-    moved, first = a.step(1, GOAL, [650.0, 1600.0])  # short of /a/: aimed beyond it
-    assert moved and first[0] > GOAL[0] and first[1] < GOAL[1]
-    moved, second = a.step(1, GOAL, [700.0, 1500.0])  # nearer with it: further still
-    assert moved and second[0] > first[0] and second[1] < first[1]
-    moved, back = a.step(1, GOAL, [600.0, 1800.0])  # further off than before: the aim before, and no more
-    assert moved and back == pytest.approx(first)
-    assert a.step(1, GOAL, [650.0, 1700.0]) == (False, pytest.approx(first))
-    moved, closed = Aiming().step(2, GOAL, [np.nan, np.nan])  # no formants heard: nothing to aim by
-    assert not moved and closed is None
+    moved, first, back = a.step(1, GOAL, [650.0, 1600.0])  # short of /a/: aimed beyond it
+    assert moved and not back and first[0] > GOAL[0] and first[1] < GOAL[1]
+    moved, second, back = a.step(1, GOAL, [700.0, 1500.0])  # nearer with it: further still
+    assert moved and not back and second[0] > first[0] and second[1] < first[1]
+    moved, before, back = a.step(1, GOAL, [600.0, 1800.0])  # further off than before: the aim before, no more
+    assert moved and back and before == pytest.approx(first)
+    assert a.step(1, GOAL, [650.0, 1700.0]) == (False, pytest.approx(first), False)
+    moved, closed, back = Aiming().step(2, GOAL, [np.nan, np.nan])  # no formants heard: nothing to aim by
+    assert not moved and closed is None and not back
     b = Aiming()
     b.step(3, GOAL, [650.0, 1600.0])
-    assert b.step(3, GOAL, [np.nan, np.nan]) == (True, None)  # its tract closed by the aim: its own goal again
+    assert b.step(3, GOAL, [np.nan, np.nan]) == (True, None, True)  # its tract closed by the aim: its own goal
+    c = Aiming()
+    c.step(4, GOAL, [650.0, 1600.0])
+    assert c.refuse(4) is None and 4 in c.frozen and 4 not in c.aims  # refused: its goal, and no more aims
+    assert c.step(4, GOAL, [650.0, 1600.0]) == (False, None, False)

@@ -160,10 +160,11 @@ def test_a_vowel_missed_speaks_the_forces_of_its_aim_and_its_own_again_when_the_
         return {"JO": 6.0, "HG": 1.0}, "aimed", "aim.yaml"
 
     aiming = Aiming()
-    p, moved = aim_vowel(given, given, 1, t, np.array([600.0, 1700.0]), aiming, aim)
-    assert moved and p.forces_n[1] == {"JO": 6.0, "HG": 1.0} and p.solutions[1] == "aim.yaml"
+    p, moved, back = aim_vowel(given, given, 1, t, np.array([600.0, 1700.0]), aiming, aim)
+    assert moved and not back and p.forces_n[1] == {"JO": 6.0, "HG": 1.0} and p.solutions[1] == "aim.yaml"
     assert p.forces_n[0] == given.forces_n[0] and given.forces_n[1] == {"JO": 6.0, "GGp": 0.5}
     f1, f2 = asked[0].acoustic.formants_hz[:2]
     assert f1 > 750 and f2 < 1400  # aimed beyond /a/, away from where it was heard
-    back, moved = aim_vowel(p, given, 1, t, np.array([np.nan, np.nan]), aiming, aim)
-    assert moved and back.forces_n[1] == given.forces_n[1] and back.notes[1] == "solved" and len(asked) == 1
+    again, moved, back = aim_vowel(p, given, 1, t, np.array([np.nan, np.nan]), aiming, aim)
+    assert moved and back and again.forces_n[1] == given.forces_n[1] and again.notes[1] == "solved"
+    assert len(asked) == 1
