@@ -6,8 +6,8 @@ When the timing's rounds (:mod:`.timing`) hear a vowel beyond its tolerance, the
 goal by ``AIM_GAIN`` of how far it was heard off, on the Bark scale (F1 and F2 each: aim' = aim + ``AIM_GAIN``
 (goal - heard)), within ``AIM_SPAN_BARK`` of the goal.  The aim's forces are solved on the maps as the vowel's
 own are, its jaw, lips, port and where its tongue is highest kept.  A vowel heard further off with its new aim
-than with the one before (a tract it closes is infinitely far) goes back to the aim before and is not aimed
-again.  The vowel's target, and so an isolated vowel, is unchanged: only its forces in this utterance aim
+than with the one before (a tract it closes is infinitely far) goes back to the aim before and moves half as
+far from then on (below a gain of 0.1 it is not aimed again).  The vowel's target, and so an isolated vowel, is unchanged: only its forces in this utterance aim
 elsewhere.
 """
 
@@ -44,33 +44,37 @@ def distance_bark(goal_hz, heard_hz) -> float:
 @dataclass
 class Aiming:
     """The vowels of one utterance aimed in context, round by round: each one's aim (Hz), the aim before it
-    (None: its own goal) and how far the vowel was heard from its goal with that one; a vowel heard further
-    off with its aim than before goes back to the aim before and is not aimed again."""
+    (None: its own goal), how far the vowel was heard from its goal with that one and how far it moves; a
+    vowel heard further off with its aim than before goes back to the aim before and moves half as far after."""
 
     aims: dict[int, np.ndarray] = field(default_factory=dict)
     before: dict[int, np.ndarray | None] = field(default_factory=dict)
     heard_off: dict[int, float] = field(default_factory=dict)
     frozen: set[int] = field(default_factory=set)
+    gains: dict[int, float] = field(default_factory=dict)
 
     def step(self, k: int, goal_hz, heard_hz) -> tuple[bool, np.ndarray | None, bool]:
         """Vowel ``k`` missed, heard at ``heard_hz``: (whether its aim moved, its aim now: None for its goal,
         whether it went back)."""
         d = distance_bark(goal_hz, heard_hz)
-        if k in self.before and d > self.heard_off.get(k, float("inf")):  # worse than before: back, and no more
-            return True, self.refuse(k), True
+        if k in self.before and d > self.heard_off.get(k, float("inf")):  # worse than before: back, half as far
+            self.gains[k] = 0.5 * self.gains.get(k, AIM_GAIN)
+            return True, self.refuse(k, freeze=self.gains[k] < 0.1), True
         self.heard_off[k] = d
         if k in self.frozen:
             return False, self.aims.get(k), False
-        new = next_aim(self.aims.get(k, goal_hz), goal_hz, heard_hz)
+        new = next_aim(self.aims.get(k, goal_hz), goal_hz, heard_hz, self.gains.get(k, AIM_GAIN))
         if new is None or (k in self.aims and np.array_equal(new, self.aims[k])):
             return False, self.aims.get(k), False
         self.before[k] = self.aims.get(k)
         self.aims[k] = new
         return True, new, False
 
-    def refuse(self, k: int) -> np.ndarray | None:
-        """Vowel ``k``'s last aim taken back, and not aimed again: the aim before it (None: its goal)."""
-        self.frozen.add(k)
+    def refuse(self, k: int, freeze: bool = True) -> np.ndarray | None:
+        """Vowel ``k``'s last aim taken back (and, ``freeze``, not aimed again): the aim before it (None: its
+        goal)."""
+        if freeze:
+            self.frozen.add(k)
         back = self.before.pop(k, None)
         self.aims.pop(k, None)
         if back is not None:
@@ -78,7 +82,7 @@ class Aiming:
         return back
 
     def copy(self) -> "Aiming":
-        return Aiming(dict(self.aims), dict(self.before), dict(self.heard_off), set(self.frozen))
+        return Aiming(dict(self.aims), dict(self.before), dict(self.heard_off), set(self.frozen), dict(self.gains))
 
 
 def aimed(t: TargetSpec, aim_hz) -> TargetSpec:

@@ -41,7 +41,7 @@ def test_an_aimed_target_keeps_everything_but_its_first_two_formants():
     assert a.name == "a_vowel-aim-820-1250" and t.acoustic.formants_hz == [750, 1400, 2500]
 
 
-def test_a_vowel_heard_further_off_with_its_aim_goes_back_to_the_aim_before_and_stays():
+def test_a_vowel_heard_further_off_with_its_aim_goes_back_to_the_aim_before_and_moves_half_as_far_after():
     from artic_cli.speech.aims import Aiming
 
     a = Aiming()
@@ -49,9 +49,17 @@ def test_a_vowel_heard_further_off_with_its_aim_goes_back_to_the_aim_before_and_
     assert moved and not back and first[0] > GOAL[0] and first[1] < GOAL[1]
     moved, second, back = a.step(1, GOAL, [700.0, 1500.0])  # nearer with it: further still
     assert moved and not back and second[0] > first[0] and second[1] < first[1]
-    moved, before, back = a.step(1, GOAL, [600.0, 1800.0])  # further off than before: the aim before, no more
-    assert moved and back and before == pytest.approx(first)
-    assert a.step(1, GOAL, [650.0, 1700.0]) == (False, pytest.approx(first), False)
+    moved, before, back = a.step(1, GOAL, [600.0, 1800.0])  # further off than before: the aim before
+    assert moved and back and before == pytest.approx(first) and a.gains[1] == pytest.approx(0.5 * AIM_GAIN)
+    heard = np.array([700.0, 1500.0])
+    moved, third, back = a.step(1, GOAL, heard)  # aimed again from there, half as far
+    assert moved and not back
+    assert hz_to_bark(third) - hz_to_bark(first) == pytest.approx(
+        0.5 * AIM_GAIN * (hz_to_bark(GOAL) - hz_to_bark(heard)), abs=0.01)
+    for _ in range(3):  # taken back again and again: at a gain below 0.1 it is not aimed again
+        a.step(1, GOAL, [500.0, 2000.0])
+        a.step(1, GOAL, heard)
+    assert 1 in a.frozen and a.step(1, GOAL, heard)[0] is False
     moved, closed, back = Aiming().step(2, GOAL, [np.nan, np.nan])  # no formants heard: nothing to aim by
     assert not moved and closed is None and not back
     b = Aiming()
