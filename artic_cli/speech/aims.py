@@ -7,8 +7,8 @@ goal by ``AIM_GAIN`` of how far it was heard off, on the Bark scale (F1 and F2 e
 (goal - heard)), within ``AIM_SPAN_BARK`` of the goal.  The aim's forces are solved on the maps as the vowel's
 own are, its jaw, lips, port and where its tongue is highest kept.  A vowel heard further off with its new aim
 than with the one before (a tract it closes is infinitely far) goes back to the aim before and moves half as
-far from then on (below a gain of 0.1 it is not aimed again).  The vowel's target, and so an isolated vowel, is unchanged: only its forces in this utterance aim
-elsewhere.
+far from then on (below a gain of 0.1 it is not aimed again).  The vowel's target, and so an isolated vowel,
+is unchanged: only its forces in this utterance aim elsewhere.
 """
 
 from __future__ import annotations

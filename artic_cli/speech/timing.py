@@ -23,10 +23,10 @@ place read frame by frame, and the leads and presses moved by what was measured:
 A vowel not heard near enough its formants (see below) opens with a harder pulse in the next round (its
 ``drive``, :mod:`.leads`) and aims beyond its goal by a share of how far it was heard off (:mod:`.aims`); an aim
 that took it further off is taken back (its pulse not harder for that round; its next aims move half as far), and
-so are the aims of a round they made not physical, those vowels not aimed again.  A round whose simulation is not physical (an inverted brick, a tongue off the tract's
-grid) is never kept, its presses and drives become their ceilings less a step, and every press and drive above 1
-softens a step for the next.  A round faster than a speaker moves (peak speeds beyond the EMA range + 50 %)
-counts as missing the share it is too fast of every constriction's interval; the next round is the same with
+so are the aims of a round they made not physical, those vowels not aimed again.  Any other round whose
+simulation is not physical (an inverted brick, a tongue off the tract's grid) is never kept, its presses and
+drives become their ceilings less a step, and every press and drive above 1 softens a step for the next.  A
+round faster than a speaker moves (peak speeds beyond the EMA range + 50 %) counts as missing the share it is too fast of every constriction's interval; the next round is the same with
 its presses a step softer, or, no press being above 1, with the pulse of the segment whose forces switched on
 last before the fastest movement softer (the vowels' drives are kept: they are what reaches the vowels); when the
 round so slowed is too fast again, it is corrected as any other, its presses and that pulse softer as well.

@@ -311,8 +311,7 @@ def timed_once(u: Utterance, p: Plan, cfg: Config, model, rest, targets, cache: 
         aimed_plan = replace(p, **{k: kept[k] for k in ("forces_n", "notes", "solutions")}) if kept else None
         return with_leads(u, hit["leads_ms"], hit["press"], hit["drive"]), Timing(
             leads_ms=hit["leads_ms"].tolist(), press=hit["press"].tolist(), rounds=0, onset_late_ms={},
-            released_early_ms={}, held_late_ms={}, drive=hit["drive"].tolist(),
-            plan=aimed_plan,
+            released_early_ms={}, held_late_ms={}, drive=hit["drive"].tolist(), plan=aimed_plan,
             aims_hz={int(k): v for k, v in kept.get("aims_hz", {}).items()})
     out, timing = timed(u, p, cfg, model, rest, targets, aim=aim)
     if timing is not None:
