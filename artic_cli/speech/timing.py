@@ -20,25 +20,24 @@ place read frame by frame, and the leads and presses moved by what was measured:
 * one still held more than ``HELD_MS`` after its end brings the next segment's switch forward by as long
   (a release on time: a stop's burst inside its interval, a voiced closure no longer than its voicing lasts).
 
-A vowel not heard near enough its formants (see below) opens with a harder pulse in the next round (its
-``drive``, :mod:`.leads`) and aims beyond its goal by a share of how far it was heard off (:mod:`.aims`); an aim
-that took it further off is taken back (its pulse not harder for that round; its next aims move half as far), and
-so are the aims of a round they made not physical, those vowels not aimed again.  Any other round whose
-simulation is not physical (an inverted brick, a tongue off the tract's grid) is never kept, its presses and
-drives become their ceilings less a step, and every press and drive above 1 softens a step for the next.  A
-round faster than a speaker moves (peak speeds beyond the EMA range + 50 %) counts as missing the share it is too fast of every constriction's interval; the next round is the same with
-its presses a step softer, or, no press being above 1, with the pulse of the segment whose forces switched on
-last before the fastest movement softer (the vowels' drives are kept: they are what reaches the vowels); when the
-round so slowed is too fast again, it is corrected as any other, its presses and that pulse softer as well.
-Leads keep their bounds (:mod:`.leads`: a segment after a vowel switches on no earlier than the vowel's middle
-until it may press no harder).  The rounds stop when nothing
-moves or every constriction is on time; of the rounds within the speed limits (any, when none is) the one that
-missed the fewest ms of its constrictions' intervals and of its vowels is the one kept (the corrections of a
-closure and of the channel after it can swing), with what it measured.  A voiced vowel counts as missed by as much
-of its duration as its F1 or F2 (the tract's own, over its middle half) stay beyond its tolerance from its
-formant goal, a share growing to all of it ``VOWEL_SPAN`` tolerances further: a consonant that leads so far
-into a vowel that the vowel is not heard costs that vowel.  A devoiced vowel is not heard (the judge asks only
-that it be voiceless).
+A vowel not heard near enough its formants (see below) opens with a harder pulse in the next round (its ``drive``,
+:mod:`.leads`) and aims beyond its goal by a share of how far it was heard off (:mod:`.aims`); an aim that took it
+further off is taken back (its pulse not harder for that round; its next aims move half as far), and so are the aims
+of a round they made not physical, those vowels not aimed again.  Any other round whose simulation is not physical
+(an inverted brick, a tongue off the tract's grid) is never kept, its presses and drives become their ceilings less
+a step, and every press and drive above 1 softens a step for the next.  A round faster than a speaker moves (peak
+speeds beyond the EMA range + 50 %) counts as missing the share it is too fast of every constriction's interval; the
+next round is the same with its presses a step softer, or, no press being above 1, with the pulse of the segment
+whose forces switched on last before the fastest movement softer (the vowels' drives are kept: they are what reaches
+the vowels); when the round so slowed is too fast again, it is corrected as any other, its presses and that pulse
+softer as well.  Leads keep their bounds (:mod:`.leads`: a segment after a vowel switches on no earlier than the
+vowel's middle until it may press no harder).  The rounds stop when nothing moves or every constriction is on time;
+of the rounds within the speed limits (any, when none is) the one that missed the fewest ms of its constrictions'
+intervals and of its vowels is the one kept (the corrections of a closure and of the channel after it can swing),
+with what it measured.  A voiced vowel counts as missed by as much of its duration as its F1 or F2 (the tract's own,
+over its middle half) stay beyond its tolerance from its formant goal, a share growing to all of it ``VOWEL_SPAN``
+tolerances further: a consonant that leads so far into a vowel that the vowel is not heard costs that vowel.  A
+devoiced vowel is not heard (the judge asks only that it be voiceless).
 """
 
 from __future__ import annotations
