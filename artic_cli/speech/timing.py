@@ -209,13 +209,6 @@ def shares_missed(vowels: list, heard: dict[int, np.ndarray]) -> dict[int, float
     return out
 
 
-def heard_shares(vowels: list, starts: np.ndarray, ends: np.ndarray, tracts, time_s: np.ndarray, cfg: Config
-                 ) -> dict[int, float]:
-    """Per vowel (segment, its acoustic goal), the share of it a round missed (:func:`heard_formants`,
-    :func:`shares_missed`)."""
-    return shares_missed(vowels, heard_formants(vowels, starts, ends, tracts, time_s, cfg))
-
-
 def fastest_switch(fast: dict[str, float], traj, model: Model, switches_ms: np.ndarray) -> int:
     """The segment whose forces switched on (``switches_ms``, rising) last before the fastest movement of the
     articulator most beyond its limit in ``fast`` (0 if none before it)."""
