@@ -19,6 +19,7 @@ import numpy as np
 
 from ..control.solver import TargetSpec
 from ..units import bark_to_hz, hz_to_bark
+from .vowel_class import bark_distance
 
 AIM_SPAN_BARK = 1.5  # an aim at most this far from its vowel's goal, F1 and F2 each
 AIM_GAIN = 0.5  # an aim moves this share of how far its vowel was heard from its goal
@@ -33,12 +34,6 @@ def next_aim(aim_hz, goal_hz, heard_hz, gain: float = AIM_GAIN) -> np.ndarray | 
     goal = hz_to_bark(np.asarray(goal_hz, float)[:2])
     moved = hz_to_bark(np.asarray(aim_hz, float)[:2]) + gain * (goal - hz_to_bark(heard))
     return np.round(bark_to_hz(np.clip(moved, goal - AIM_SPAN_BARK, goal + AIM_SPAN_BARK)), 0)
-
-
-def distance_bark(goal_hz, heard_hz) -> float:
-    """How far a vowel was heard from its goal (Bark, F1-F2 plane; a closed tract: infinitely far)."""
-    d = float(np.linalg.norm(hz_to_bark(np.asarray(heard_hz, float)[:2]) - hz_to_bark(np.asarray(goal_hz, float)[:2])))
-    return d if np.isfinite(d) else float("inf")
 
 
 @dataclass
@@ -56,10 +51,11 @@ class Aiming:
     def step(self, k: int, goal_hz, heard_hz) -> tuple[bool, np.ndarray | None, bool]:
         """Vowel ``k`` missed, heard at ``heard_hz``: (whether its aim moved, its aim now: None for its goal,
         whether it went back)."""
-        d = distance_bark(goal_hz, heard_hz)
+        d = bark_distance(goal_hz, heard_hz)
+        d = d if np.isfinite(d) else float("inf")  # a closed tract: infinitely far
         if k in self.before and d > self.heard_off.get(k, float("inf")):  # worse than before: back, half as far
             self.gains[k] = 0.5 * self.gains.get(k, AIM_GAIN)
-            return True, self.refuse(k, freeze=self.gains[k] < 0.1), True
+            return True, self.take_back(k, freeze=self.gains[k] < 0.1), True
         self.heard_off[k] = d
         if k in self.frozen:
             return False, self.aims.get(k), False
@@ -70,7 +66,7 @@ class Aiming:
         self.aims[k] = new
         return True, new, False
 
-    def refuse(self, k: int, freeze: bool = True) -> np.ndarray | None:
+    def take_back(self, k: int, freeze: bool = True) -> np.ndarray | None:
         """Vowel ``k``'s last aim taken back (and, ``freeze``, not aimed again): the aim before it (None: its
         goal)."""
         if freeze:
@@ -80,6 +76,11 @@ class Aiming:
         if back is not None:
             self.aims[k] = back
         return back
+
+    def moved_since(self, before: "Aiming") -> list[int]:
+        """The vowels whose aim differs from the one ``before`` held (or that had one then and none now)."""
+        return sorted(k for k in set(self.aims) | set(before.aims) if k not in self.aims or k not in before.aims
+                      or not np.array_equal(self.aims[k], before.aims[k]))
 
     def copy(self) -> "Aiming":
         return Aiming(dict(self.aims), dict(self.before), dict(self.heard_off), set(self.frozen), dict(self.gains))
@@ -95,4 +96,4 @@ def aimed(t: TargetSpec, aim_hz) -> TargetSpec:
     return t.model_copy(update={"acoustic": acoustic, "name": f"{t.name}-aim-{f[0]:.0f}-{f[1]:.0f}"})
 
 
-__all__ = ["AIM_GAIN", "AIM_SPAN_BARK", "Aiming", "aimed", "distance_bark", "next_aim"]
+__all__ = ["AIM_GAIN", "AIM_SPAN_BARK", "Aiming", "aimed", "next_aim"]

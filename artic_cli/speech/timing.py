@@ -223,12 +223,6 @@ def fastest_switch(fast: dict[str, float], traj, model: Model, switches_ms: np.n
 Aim = Callable[[TargetSpec], tuple[dict[str, float], str, str]]  # a target -> its forces, how found, its file
 
 
-def moved_aims(aims: dict[int, np.ndarray], before: dict[int, np.ndarray]) -> list[int]:
-    """The vowels whose aim differs from the one ``before`` (or that had one before and none now)."""
-    return sorted(k for k in set(aims) | set(before) if k not in aims or k not in before
-                  or not np.array_equal(aims[k], before[k]))
-
-
 def vowels_missed(p: Plan, given: Plan, shares: dict, heard_hz: dict, targets: list, aiming: Aiming,
                   aim: Aim | None, kn: Leads) -> tuple[Plan, bool]:
     """Each vowel a round missed aimed further (:func:`aim_vowel`, when ``aim`` is given) and its pulse harder,
@@ -247,7 +241,7 @@ def vowels_missed(p: Plan, given: Plan, shares: dict, heard_hz: dict, targets: l
 def aimed_back(physical: tuple[Plan, Aiming] | None, aiming: Aiming) -> tuple[Plan, Aiming] | None:
     """After a round that was not physical, when vowels were aimed anew since the last ``physical`` round (its
     plan and aims): that round's plan and aims, those vowels not aimed again; else None."""
-    moved = [] if physical is None else moved_aims(aiming.aims, physical[1].aims)
+    moved = [] if physical is None else aiming.moved_since(physical[1])
     if not moved:
         return None
     back = physical[1].copy()
@@ -340,7 +334,7 @@ def timed(u: Utterance, p: Plan, cfg: Config, model: Model, rest, targets: list[
         key = (bool(fast), score)  # a round within the speed limits before any beyond them
         if best is None or key < best[0]:
             best = (key, r, tried, late, early, held, traj, *physical)
-        changed &= bool(moved_aims(aiming.aims, physical[1].aims)) or not all(  # all bound
+        changed &= bool(aiming.moved_since(physical[1])) or not all(  # all bound
             np.array_equal(a, b) for a, b in zip((kn.leads, kn.press, kn.drive), tried))
         slowing = slowed
         if not changed or score == 0.0:

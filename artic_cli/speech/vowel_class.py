@@ -8,10 +8,15 @@ import numpy as np
 from .. import units
 
 
+def bark_distance(a_hz, b_hz) -> float:
+    """How far apart two (F1, F2) pairs (Hz) lie in Bark (NaN when either has no formants)."""
+    return float(np.linalg.norm(units.hz_to_bark(np.asarray(a_hz, float)[:2]) -
+                                units.hz_to_bark(np.asarray(b_hz, float)[:2])))
+
+
 def nearest_vowel(f1_hz: float, f2_hz: float, means_hz: dict[str, tuple[float, float]]) -> str:
     """The vowel whose mean (F1, F2 Hz) lies nearest (F1, F2) in Bark."""
-    z = units.hz_to_bark(np.array([f1_hz, f2_hz], float))
-    return min(means_hz, key=lambda v: float(np.sum((units.hz_to_bark(np.asarray(means_hz[v][:2], float)) - z) ** 2)))
+    return min(means_hz, key=lambda v: bark_distance((f1_hz, f2_hz), means_hz[v]))
 
 
 def heard_vowels(intervals: list[tuple[float, float, str]], time_s: np.ndarray, formants_hz: np.ndarray,
@@ -39,4 +44,4 @@ def heard_text(h: dict) -> str:
     return f"heard /{h['heard']}/ ({h['f1_hz']:.0f} / {h['f2_hz']:.0f} Hz)"
 
 
-__all__ = ["heard_text", "heard_vowels", "nearest_vowel"]
+__all__ = ["bark_distance", "heard_text", "heard_vowels", "nearest_vowel"]

@@ -67,5 +67,5 @@ def test_a_vowel_heard_further_off_with_its_aim_goes_back_to_the_aim_before_and_
     assert b.step(3, GOAL, [np.nan, np.nan]) == (True, None, True)  # its tract closed by the aim: its own goal
     c = Aiming()
     c.step(4, GOAL, [650.0, 1600.0])
-    assert c.refuse(4) is None and 4 in c.frozen and 4 not in c.aims  # refused: its goal, and no more aims
+    assert c.take_back(4) is None and 4 in c.frozen and 4 not in c.aims  # taken back for good: its goal, no more aims
     assert c.step(4, GOAL, [650.0, 1600.0]) == (False, None, False)

@@ -319,10 +319,9 @@ def _middle(a, b):
 
 def _class_margin(f, means) -> float:
     """How much nearer (Bark) formants ``f`` lie to their nearest vowel mean than to the next."""
-    from artic_cli.units import hz_to_bark
+    from artic_cli.speech.vowel_class import bark_distance
 
-    d = sorted(float(np.linalg.norm(hz_to_bark(np.asarray(f[:2], float)) - hz_to_bark(np.asarray(m, float))))
-               for m in means.values())
+    d = sorted(bark_distance(f, m) for m in means.values())
     return d[1] - d[0]
 
 
